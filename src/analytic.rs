@@ -1,0 +1,318 @@
+//! Classical (local) series solutions of the papers' benchmarks, for comparison.
+//!
+//! All are separation-of-variables series of the heat equation θ_t = α ∇²θ along one axis
+//! (or two, for the square), written in the coordinate s = x − x0 along the bar.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// A classical reference solution with its parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Reference {
+    /// Both ends held, constant initial temperature (seed 000 eq 33; seed 004 §4.1).
+    BarFixedEnds {
+        /// Coordinate of the left end, m.
+        x0: f64,
+        /// Length L, m.
+        length: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ at s = 0, °C.
+        left: f64,
+        /// θ at s = L, °C.
+        right: f64,
+        /// Initial θ, °C.
+        initial: f64,
+    },
+    /// Left end insulated, right end held, two-step initial field (seed 000 eq 38).
+    BarInsulatedLeft {
+        /// Coordinate of the left end, m.
+        x0: f64,
+        /// Length L, m.
+        length: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ at s = L, °C.
+        right: f64,
+        /// Initial θ on s < L/2, °C.
+        initial_left: f64,
+        /// Initial θ on s > L/2, °C.
+        initial_right: f64,
+    },
+    /// Left end held, gradient θ_s given at the right end (seed 000 eq 43; seed 003 eq 18 with 0).
+    BarFixedFlux {
+        /// Coordinate of the left end, m.
+        x0: f64,
+        /// Length L, m.
+        length: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ at s = 0, °C.
+        left: f64,
+        /// θ_s at s = L, K/m (q/κ).
+        gradient: f64,
+        /// Initial θ, °C.
+        initial: f64,
+    },
+    /// Left end at A t e^(−r t), right end insulated, initial 0 (seed 004 §4.2, Duhamel).
+    BarPulseLeft {
+        /// Coordinate of the left end, m.
+        x0: f64,
+        /// Length L, m.
+        length: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// Amplitude A, K/s.
+        amplitude: f64,
+        /// Rate r, 1/s.
+        rate: f64,
+    },
+    /// Square with all edges held, constant initial temperature (seed 003 Example 1).
+    SquareFixedEdges {
+        /// Coordinates of the lower-left corner, m.
+        x0: f64,
+        /// See `x0`.
+        y0: f64,
+        /// Side L, m.
+        length: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// Edge temperature, °C.
+        edge: f64,
+        /// Initial θ, °C.
+        initial: f64,
+    },
+}
+
+/// Number of series terms so that e^(−α λ_n² t) < e^(−40) beyond, with λ_n = c n.
+fn terms(alpha: f64, t: f64, c: f64) -> usize {
+    let n = if t > 0.0 { (40.0 / (alpha * t)).sqrt() / c } else { f64::INFINITY };
+    (n.ceil() as usize + 2).clamp(200, 200_000)
+}
+
+/// (4/π) Σ_{m odd} sin(mπs/L)/m e^(−α m²π² t/L²): the unit solution of a slab held at 0.
+fn slab(s: f64, l: f64, alpha: f64, t: f64) -> f64 {
+    let c = PI / l;
+    let n = terms(alpha, t, c);
+    let mut sum = 0.0;
+    for m in (1..=n).step_by(2) {
+        let lam = c * m as f64;
+        sum += (lam * s).sin() / m as f64 * (-alpha * lam * lam * t).exp();
+    }
+    4.0 / PI * sum
+}
+
+impl Reference {
+    /// The classical temperature at a point and time, °C.
+    pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
+        match *self {
+            Reference::BarFixedEnds {
+                x0,
+                length: l,
+                diffusivity: a,
+                left,
+                right,
+                initial,
+            } => {
+                let s = x - x0;
+                let c = PI / l;
+                let mut sum = left + (right - left) * s / l;
+                for n in 1..=terms(a, t, c) {
+                    let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+                    let b = 2.0 / (n as f64 * PI) * (initial * (1.0 - sign) - left + right * sign);
+                    let lam = c * n as f64;
+                    sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
+                }
+                sum
+            }
+            Reference::BarInsulatedLeft {
+                x0,
+                length: l,
+                diffusivity: a,
+                right,
+                initial_left,
+                initial_right,
+            } => {
+                let s = x - x0;
+                let mut sum = right;
+                let c = PI / (2.0 * l);
+                for n in 1..=terms(a, t, 2.0 * c) {
+                    let lam = c * (2 * n - 1) as f64;
+                    let cn = 2.0 / (l * lam)
+                        * ((initial_left - right) * (lam * l / 2.0).sin()
+                            + (initial_right - right) * ((lam * l).sin() - (lam * l / 2.0).sin()));
+                    sum += cn * (lam * s).cos() * (-a * lam * lam * t).exp();
+                }
+                sum
+            }
+            Reference::BarFixedFlux {
+                x0,
+                length: l,
+                diffusivity: a,
+                left,
+                gradient: g,
+                initial,
+            } => {
+                let s = x - x0;
+                let mut sum = left + g * s;
+                let c = PI / (2.0 * l);
+                for n in 1..=terms(a, t, 2.0 * c) {
+                    let lam = c * (2 * n - 1) as f64;
+                    let alt = if n % 2 == 1 { 1.0 } else { -1.0 };
+                    let b = 2.0 / l * ((initial - left) / lam - g * alt / (lam * lam));
+                    sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
+                }
+                sum
+            }
+            Reference::BarPulseLeft {
+                x0,
+                length: l,
+                diffusivity: a,
+                amplitude: amp,
+                rate: r,
+            } => {
+                let s = x - x0;
+                let g = amp * t * (-r * t).exp();
+                let c = PI / (2.0 * l);
+                let mut sum = g;
+                let nmax = terms(a, t, 2.0 * c).max(4000);
+                for n in 1..=nmax {
+                    let lam = c * (2 * n - 1) as f64;
+                    let mu = a * lam * lam;
+                    let an = 2.0 / (l * lam);
+                    sum -= an * duhamel(amp, r, mu, t) * (lam * s).sin();
+                }
+                sum
+            }
+            Reference::SquareFixedEdges {
+                x0,
+                y0,
+                length: l,
+                diffusivity: a,
+                edge,
+                initial,
+            } => edge + (initial - edge) * slab(x - x0, l, a, t) * slab(y - y0, l, a, t),
+        }
+    }
+}
+
+/// ∫_0^t e^(−μ(t−τ)) g'(τ) dτ for g = A τ e^(−rτ).
+fn duhamel(amp: f64, r: f64, mu: f64, t: f64) -> f64 {
+    let nu = mu - r;
+    if (nu * t).abs() > 1e-3 {
+        let er = (-r * t).exp();
+        let em = (-mu * t).exp();
+        amp * ((er - em) / nu - r * (er * (nu * t - 1.0) + em) / (nu * nu))
+    } else {
+        // Simpson's rule where the closed form cancels
+        let n = 2000;
+        let h = t / n as f64;
+        let f = |tau: f64| (-mu * (t - tau)).exp() * amp * (-r * tau).exp() * (1.0 - r * tau);
+        let mut s = f(0.0) + f(t);
+        for i in 1..n {
+            s += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        s * h / 3.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Seed 000's printed midpoint values at t = 8 s (±0.005 °C: the paper prints 2 decimals).
+    #[test]
+    fn seed000_midpoints() {
+        let ex1 = Reference::BarFixedEnds {
+            x0: 0.0,
+            length: 10.0,
+            diffusivity: 1.14,
+            left: 0.0,
+            right: 0.0,
+            initial: 100.0,
+        };
+        assert!((ex1.eval(5.0, 0.0, 8.0) - 51.75).abs() < 0.005, "{}", ex1.eval(5.0, 0.0, 8.0));
+        let ex2 = Reference::BarInsulatedLeft {
+            x0: 0.0,
+            length: 10.0,
+            diffusivity: 1.14,
+            right: 100.0,
+            initial_left: 60.0,
+            initial_right: 0.0,
+        };
+        assert!((ex2.eval(5.0, 0.0, 8.0) - 53.06).abs() < 0.005, "{}", ex2.eval(5.0, 0.0, 8.0));
+    }
+
+    /// Each series reproduces its initial and boundary data (tolerance from truncation).
+    #[test]
+    fn series_meet_their_data() {
+        let ex3 = Reference::BarFixedFlux {
+            x0: 0.0,
+            length: PI,
+            diffusivity: 1.14,
+            left: 20.0,
+            gradient: 3.0,
+            initial: 0.0,
+        };
+        assert!(ex3.eval(1.0, 0.0, 1e-6).abs() < 1e-2);
+        assert!((ex3.eval(0.0, 0.0, 0.5) - 20.0).abs() < 1e-9);
+        let h = 1e-5;
+        let grad = (ex3.eval(PI, 0.0, 0.5) - ex3.eval(PI - h, 0.0, 0.5)) / h;
+        assert!((grad - 3.0).abs() < 1e-3, "{grad}");
+        let shock = Reference::BarPulseLeft {
+            x0: -5.0,
+            length: 10.0,
+            diffusivity: 1.0,
+            amplitude: 5.0,
+            rate: 2.0,
+        };
+        let t: f64 = 0.8;
+        assert!((shock.eval(-5.0, 0.0, t) - 5.0 * t * (-2.0 * t).exp()).abs() < 1e-9);
+        assert!(shock.eval(4.0, 0.0, 0.3).abs() < 1e-6);
+        let sq = Reference::SquareFixedEdges {
+            x0: 0.0,
+            y0: 0.0,
+            length: 1.0,
+            diffusivity: 1.14,
+            edge: 0.0,
+            initial: 40.0,
+        };
+        assert!((sq.eval(0.5, 0.5, 1e-7) - 40.0).abs() < 1e-3);
+        assert!(sq.eval(0.0, 0.3, 0.01).abs() < 1e-12);
+    }
+
+    /// The Duhamel series against a fine explicit finite-difference solve (tolerance 2e-3 °C
+    /// from the FD grid h = 0.05, Δt = 1e-3).
+    #[test]
+    fn pulse_series_matches_finite_differences() {
+        let (l, a) = (10.0, 1.0);
+        let n = 200;
+        let h = l / n as f64;
+        let dt = 0.2 * h * h / a;
+        let steps = (3.0 / dt).round() as usize;
+        let dt = 3.0 / steps as f64;
+        let mut u = vec![0.0; n + 1];
+        let mut next = u.clone();
+        for s in 0..steps {
+            let t = (s + 1) as f64 * dt;
+            for i in 1..n {
+                next[i] = u[i] + a * dt / (h * h) * (u[i - 1] - 2.0 * u[i] + u[i + 1]);
+            }
+            next[n] = u[n] + a * dt / (h * h) * 2.0 * (u[n - 1] - u[n]);
+            next[0] = 5.0 * t * (-2.0 * t).exp();
+            std::mem::swap(&mut u, &mut next);
+        }
+        let r = Reference::BarPulseLeft {
+            x0: 0.0,
+            length: l,
+            diffusivity: a,
+            amplitude: 5.0,
+            rate: 2.0,
+        };
+        for i in (0..=n).step_by(10) {
+            let e = r.eval(i as f64 * h, 0.0, 3.0);
+            assert!((e - u[i]).abs() < 2e-3, "x = {}: {} vs {}", i as f64 * h, e, u[i]);
+        }
+    }
+}

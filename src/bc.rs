@@ -1,0 +1,423 @@
+//! Boundary conditions and loads of formulation §3, applied to a state vector.
+//!
+//! Constraints overwrite node temperatures at each stage (nodal Dirichlet, the 1D flux
+//! relation of seed 000 eq 22, the nodal flux relation of seed 003 §3.2, and the
+//! fictitious layers of seed 004 / seed 001); loads add to the rates (convection of
+//! seed 001, volumetric sources).
+
+use crate::cloud::{Cloud, Face};
+use crate::expr::Expr;
+use crate::math::{NodeId, Point};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use std::num::NonZero;
+
+/// How a fictitious layer takes its temperature from the body (formulation §3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layer {
+    /// θ_f = θ_b(t).
+    Naive,
+    /// Reflection of the body field across the face (Dirichlet, insulated or flux rule).
+    Mirror,
+}
+
+/// The condition on one face of a box geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FaceBc {
+    /// No bonds leave the body: insulated with the surface skin effect (seed 003 §3.5).
+    Free,
+    /// Nodal Dirichlet on the first `layers` node layers (seeds 000, 003).
+    NodalTemperature {
+        /// θ_b(x, y, z, t), °C.
+        value: Expr,
+        /// Number of node layers held.
+        layers: f64,
+    },
+    /// Dirichlet through a fictitious layer.
+    LayerTemperature {
+        /// θ_b(x, y, z, t), °C.
+        value: Expr,
+        /// Naive or mirror.
+        layer: Layer,
+    },
+    /// Zero flux through a mirrored fictitious layer.
+    LayerInsulated,
+    /// Heat flux into the body through a mirrored fictitious layer, θ_f = θ_m + (q/k) d.
+    LayerFlux {
+        /// q(x, y, z, t) into the body, W/m².
+        value: Expr,
+    },
+    /// Heat flux into the body by a nodal relation: seed 000 eq 22 in 1D, seed 003 §3.2 in 2D/3D.
+    RelationFlux {
+        /// q(x, y, z, t) into the body, W/m².
+        value: Expr,
+    },
+    /// Convection to an ambient temperature (seed 001): s = h A (T∞ − θ)/V on surface nodes.
+    Convection {
+        /// Film coefficient h, W/(m²·K).
+        h: f64,
+        /// T∞(t), °C.
+        ambient: Expr,
+    },
+}
+
+impl FaceBc {
+    /// True when the condition needs a fictitious layer.
+    pub fn needs_layer(&self) -> bool {
+        matches!(self, FaceBc::LayerTemperature { .. } | FaceBc::LayerInsulated | FaceBc::LayerFlux { .. })
+    }
+}
+
+/// Nodes held at θ_b(x, t).
+#[derive(Debug, Clone)]
+struct Nodal {
+    nodes: Vec<usize>,
+    value: Expr,
+}
+
+/// Seed 000 eq 22: θ_s = θ_anchor + (q/k)(d_anchor − d_s) for the nodes within δ of the end.
+#[derive(Debug, Clone)]
+struct Relation1d {
+    slaved: Vec<(usize, f64)>,
+    anchor: usize,
+    value: Expr,
+    conductivity: f64,
+    at: Point,
+}
+
+/// Seed 003 §3.2: θ_i = (Σ_p w_p θ_p + q) / Σ_p w_p over the inward half of H_i.
+#[derive(Debug, Clone)]
+struct RelationNodal {
+    node: usize,
+    stencil: Vec<(NodeId, f64)>,
+    wsum: f64,
+    value: Expr,
+}
+
+/// One fictitious node's rule: θ_f = σ θ(mirror) + Σ coef · g_face(t, d).
+#[derive(Debug, Clone)]
+struct Ghost {
+    node: usize,
+    sigma: f64,
+    stencil: Vec<(NodeId, f64)>,
+    terms: Vec<(Face, f64, f64, Point)>,
+}
+
+/// Convection on surface nodes.
+#[derive(Debug, Clone)]
+struct Convective {
+    nodes: Vec<(usize, f64)>,
+    h: f64,
+    ambient: Expr,
+}
+
+/// All boundary conditions and loads of a model, ready to apply.
+#[derive(Debug, Clone, Default)]
+pub struct Boundary {
+    faces: Vec<FaceBc>,
+    nodal: Vec<Nodal>,
+    relation1d: Vec<Relation1d>,
+    relation_nodal: Vec<RelationNodal>,
+    ghosts: Vec<Ghost>,
+    convective: Vec<Convective>,
+    /// Volumetric source s(x, t), W/m³, divided by ρc at each node when loaded.
+    source: Option<Expr>,
+    /// Precomputed s/ρc per body node when the source does not depend on t, K/s.
+    source_fixed: Vec<f64>,
+    /// True for body nodes whose temperature is set by a constraint.
+    pub driven: Vec<bool>,
+}
+
+/// Everything needed to build the boundary from a cloud.
+pub struct BoundaryInput<'a> {
+    /// The cloud, with fictitious nodes already generated.
+    pub cloud: &'a Cloud,
+    /// Per-face conditions (6 entries, unused axes Free).
+    pub faces: Vec<FaceBc>,
+    /// Conductivity per node, W/(m·K).
+    pub conductivity: &'a [f64],
+    /// Volumetric heat capacity per node, J/(m³·K).
+    pub capacity: &'a [f64],
+    /// Directed bonds and their micro-conductance per unit volume pair (for seed 003 §3.2).
+    pub micro: Option<(&'a crate::neighbors::Horizons, &'a [f64])>,
+    /// Volumetric source, W/m³.
+    pub source: Option<Expr>,
+}
+
+fn project(cloud: &Cloud, p: &Point, face: Face) -> Point {
+    let mut q = *p;
+    let a = face / 2;
+    q[a] = if face % 2 == 0 { cloud.min[a] } else { cloud.max[a] };
+    q
+}
+
+fn reflect(cloud: &Cloud, p: &Point, face: Face) -> Point {
+    let mut q = *p;
+    let a = face / 2;
+    let plane = if face % 2 == 0 { cloud.min[a] } else { cloud.max[a] };
+    q[a] = 2.0 * plane - p[a];
+    q
+}
+
+impl Boundary {
+    /// Builds the constraint and load structures.
+    pub fn build(input: BoundaryInput) -> Self {
+        let cloud = input.cloud;
+        let nb = cloud.n_body;
+        let mut b = Boundary {
+            faces: input.faces.clone(),
+            driven: vec![false; nb],
+            source: input.source.clone(),
+            ..Default::default()
+        };
+        for (face, bc) in input.faces.iter().enumerate() {
+            match bc {
+                FaceBc::NodalTemperature { value, layers } => {
+                    let nodes = cloud.face_layer(face, *layers);
+                    b.nodal.push(Nodal {
+                        nodes,
+                        value: value.clone(),
+                    });
+                }
+                FaceBc::RelationFlux { value } if cloud.dim == 1 => {
+                    let mut slaved = Vec::new();
+                    let mut anchor = None;
+                    let mut best = f64::INFINITY;
+                    for i in 0..nb {
+                        let d = cloud.distance_to_face(&cloud.pos[i], face);
+                        if d < cloud.horizon[i] * (1.0 - 1e-9) {
+                            slaved.push((i, d));
+                        } else if d < best {
+                            best = d;
+                            anchor = Some(i);
+                        }
+                    }
+                    if let Some(a) = anchor {
+                        b.relation1d.push(Relation1d {
+                            slaved: slaved.into_iter().map(|(i, d)| (i, best - d)).collect(),
+                            anchor: a,
+                            value: value.clone(),
+                            conductivity: input.conductivity[a],
+                            at: project(cloud, &cloud.pos[a], face),
+                        });
+                    }
+                }
+                FaceBc::RelationFlux { value } => {
+                    let (h, micro) = input.micro.expect("micro-conductances are given for nodal flux relations");
+                    let a = face / 2;
+                    let inward = if face % 2 == 0 { 1.0 } else { -1.0 };
+                    for i in cloud.face_layer(face, 1.0) {
+                        let mut stencil = Vec::new();
+                        let mut wsum = 0.0;
+                        for bnd in h.row(i) {
+                            let j = h.targets[bnd] as usize;
+                            let l = (cloud.pos[j][a] - cloud.pos[i][a]) * inward;
+                            if l > 0.0 && j < nb {
+                                let w = micro[bnd] * l;
+                                stencil.push((j as NodeId, w));
+                                wsum += w;
+                            }
+                        }
+                        if wsum > 0.0 {
+                            b.relation_nodal.push(RelationNodal {
+                                node: i,
+                                stencil,
+                                wsum,
+                                value: value.clone(),
+                            });
+                        }
+                    }
+                }
+                FaceBc::Convection { h, ambient } => {
+                    let nodes = cloud
+                        .face_layer(face, 1.0)
+                        .into_iter()
+                        .map(|i| (i, *h * cloud.exposed_area(i) / (cloud.volume[i] * input.capacity[i])))
+                        .collect();
+                    b.convective.push(Convective {
+                        nodes,
+                        h: *h,
+                        ambient: ambient.clone(),
+                    });
+                }
+                _ => {}
+            }
+        }
+        for n in &b.nodal {
+            for &i in &n.nodes {
+                b.driven[i] = true;
+            }
+        }
+        for r in &b.relation1d {
+            for &(i, _) in &r.slaved {
+                b.driven[i] = true;
+            }
+        }
+        for r in &b.relation_nodal {
+            b.driven[r.node] = true;
+        }
+        b.build_ghosts(cloud, input.conductivity);
+        if let Some(s) = &b.source {
+            if s.is_time_independent() {
+                b.source_fixed = (0..nb)
+                    .map(|i| {
+                        let p = cloud.pos[i];
+                        s.eval(p.x, p.y, p.z, 0.0) / input.capacity[i]
+                    })
+                    .collect();
+            }
+        }
+        b
+    }
+
+    fn build_ghosts(&mut self, cloud: &Cloud, conductivity: &[f64]) {
+        if cloud.n_fictitious() == 0 {
+            return;
+        }
+        let body: Vec<[f64; 3]> = cloud.pos[..cloud.n_body].iter().map(|p| [p.x, p.y, p.z]).collect();
+        if body.is_empty() {
+            return;
+        }
+        let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&body).expect("non-empty body");
+        let k_near = NonZero::new(1usize << cloud.dim).expect("non-zero");
+        for f in 0..cloud.n_fictitious() {
+            let node = cloud.n_body + f;
+            let mask = cloud.outside[f];
+            // naive faces first: they fix the value whatever follows
+            let mut faces: Vec<Face> = (0..6).filter(|&fc| mask & (1 << fc) != 0).collect();
+            faces.sort_by_key(|&fc| !matches!(self.faces[fc], FaceBc::LayerTemperature { layer: Layer::Naive, .. }));
+            let mut p = cloud.pos[node];
+            let mut s = 1.0;
+            let mut terms = Vec::new();
+            for &fc in &faces {
+                let q = reflect(cloud, &p, fc);
+                let d = (q - p).norm();
+                let (sigma, coef) = match &self.faces[fc] {
+                    FaceBc::LayerTemperature { layer: Layer::Naive, .. } => (0.0, 1.0),
+                    FaceBc::LayerTemperature { layer: Layer::Mirror, .. } => (-1.0, 2.0),
+                    FaceBc::LayerFlux { .. } => (1.0, 1.0 / conductivity[node]),
+                    _ => (1.0, 0.0),
+                };
+                if coef != 0.0 && s != 0.0 {
+                    terms.push((fc, s * coef, d, project(cloud, &p, fc)));
+                }
+                s *= sigma;
+                p = q;
+            }
+            let mut stencil = Vec::new();
+            if s != 0.0 {
+                let near = tree
+                    .query(&[p.x, p.y, p.z])
+                    .nearest_n::<SquaredEuclidean<f64>>(k_near)
+                    .execute();
+                let exact = near[0].distance.sqrt() <= 1e-6 * cloud.spacing[node];
+                if exact {
+                    stencil.push((near[0].item as NodeId, 1.0));
+                } else {
+                    let ws: Vec<f64> = near.iter().map(|it| 1.0 / it.distance.sqrt()).collect();
+                    let tot: f64 = ws.iter().sum();
+                    for (it, w) in near.iter().zip(ws) {
+                        stencil.push((it.item as NodeId, w / tot));
+                    }
+                }
+            }
+            self.ghosts.push(Ghost {
+                node,
+                sigma: s,
+                stencil,
+                terms,
+            });
+        }
+    }
+
+    /// Sets every constrained body node and every fictitious node at time `t`.
+    pub fn apply(&self, cloud: &Cloud, theta: &mut [f64], t: f64) {
+        for n in &self.nodal {
+            if n.value.is_uniform() {
+                let v = n.value.eval(0.0, 0.0, 0.0, t);
+                for &i in &n.nodes {
+                    theta[i] = v;
+                }
+            } else {
+                for &i in &n.nodes {
+                    let p = cloud.pos[i];
+                    theta[i] = n.value.eval(p.x, p.y, p.z, t);
+                }
+            }
+        }
+        for r in &self.relation1d {
+            let g = r.value.eval(r.at.x, r.at.y, r.at.z, t) / r.conductivity;
+            let base = theta[r.anchor];
+            for &(i, d) in &r.slaved {
+                theta[i] = base + g * d;
+            }
+        }
+        for r in &self.relation_nodal {
+            let p = cloud.pos[r.node];
+            let q = r.value.eval(p.x, p.y, p.z, t);
+            let s: f64 = r.stencil.iter().map(|&(j, w)| w * theta[j as usize]).sum();
+            theta[r.node] = (s + q) / r.wsum;
+        }
+        for g in &self.ghosts {
+            let mut v = 0.0;
+            if g.sigma != 0.0 {
+                let m: f64 = g.stencil.iter().map(|&(j, w)| w * theta[j as usize]).sum();
+                v = g.sigma * m;
+            }
+            for &(fc, coef, d, at) in &g.terms {
+                let val = match &self.faces[fc] {
+                    FaceBc::LayerTemperature { value, .. } => value.eval(at.x, at.y, at.z, t),
+                    FaceBc::LayerFlux { value } => value.eval(at.x, at.y, at.z, t) * d,
+                    _ => 0.0,
+                };
+                v += coef * val;
+            }
+            theta[g.node] = v;
+        }
+    }
+
+    /// Adds the load rates (convection, volumetric source) of body nodes, K/s.
+    pub fn add_loads(&self, cloud: &Cloud, capacity: &[f64], theta: &[f64], t: f64, rate: &mut [f64]) {
+        for c in &self.convective {
+            let amb = c.ambient.eval(0.0, 0.0, 0.0, t);
+            for &(i, coef) in &c.nodes {
+                rate[i] += coef * (amb - theta[i]);
+            }
+        }
+        if !self.source_fixed.is_empty() {
+            for (r, s) in rate.iter_mut().zip(&self.source_fixed) {
+                *r += s;
+            }
+        } else if let Some(s) = &self.source {
+            for (i, r) in rate.iter_mut().enumerate() {
+                let p = cloud.pos[i];
+                *r += s.eval(p.x, p.y, p.z, t) / capacity[i];
+            }
+        }
+    }
+
+    /// Largest load coefficient per body node that adds to the diagonal (for the Δt bound), 1/s.
+    pub fn load_diagonal(&self, n_body: usize) -> Vec<f64> {
+        let mut d = vec![0.0; n_body];
+        for c in &self.convective {
+            for &(i, coef) in &c.nodes {
+                d[i] += coef;
+            }
+        }
+        d
+    }
+
+    /// Convection coefficient sum h of all convective faces (for reporting), W/(m²·K).
+    pub fn convective_h(&self) -> f64 {
+        self.convective.iter().map(|c| c.h).sum()
+    }
+
+    /// True when convection or a source adds to the rates.
+    pub fn has_loads(&self) -> bool {
+        !self.convective.is_empty() || self.source.is_some()
+    }
+
+    /// Number of fictitious nodes with a rule.
+    pub fn n_ghosts(&self) -> usize {
+        self.ghosts.len()
+    }
+}

@@ -1,0 +1,615 @@
+//! Case files: the TOML schema, its validation, and the conversion to a [`ModelSpec`].
+//!
+//! Every key is documented in the README's case-file reference. Unknown keys, missing
+//! fields and out-of-range values are errors that name the file and the key.
+
+use crate::analytic::Reference;
+use crate::bc::{FaceBc, Layer};
+use crate::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
+use crate::error::{Error, Result};
+use crate::expr::Expr;
+use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
+use crate::material::{BondRule, Material};
+use crate::model::{Initial, ModelSpec};
+use crate::solve::explicit::Integrator;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A number or an expression string.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum ValueSpec {
+    /// A constant.
+    Number(f64),
+    /// An expression of x, y, z, t.
+    Expr(String),
+}
+
+/// The whole case file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseFile {
+    /// Free text shown in run.json.
+    #[serde(default)]
+    pub title: String,
+    /// Spatial dimension, 1..=3.
+    pub dimension: usize,
+    /// The box domain.
+    pub domain: DomainSpec,
+    /// Regions tiling the domain (at least one).
+    pub region: Vec<RegionSpec>,
+    /// Materials by name.
+    pub material: BTreeMap<String, Material>,
+    /// Kernel settings.
+    #[serde(default)]
+    pub kernel: KernelSpec,
+    /// Boundary conditions by face name (x_min … z_max); missing faces are free.
+    #[serde(default)]
+    pub boundary: BTreeMap<String, BoundarySpec>,
+    /// Initial temperature.
+    #[serde(default)]
+    pub initial: InitialSpec,
+    /// Volumetric source.
+    #[serde(default)]
+    pub source: Option<SourceSpec>,
+    /// Time integration.
+    pub time: TimeSpec,
+    /// Classical reference to compare with.
+    #[serde(default)]
+    pub reference: Option<ReferenceSpec>,
+}
+
+/// `[domain]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DomainSpec {
+    /// Min corner, one coordinate per dimension, m.
+    pub min: Vec<f64>,
+    /// Max corner, m.
+    pub max: Vec<f64>,
+    /// Thickness h of a 2D body, m.
+    #[serde(default)]
+    pub thickness: Option<f64>,
+    /// Cross-section A of a 1D bar, m².
+    #[serde(default)]
+    pub area: Option<f64>,
+    /// `cell` (cell-centred nodes of equal volume) or `boundary` (nodes on the boundary).
+    #[serde(default)]
+    pub placement: Placement,
+}
+
+/// Node placement.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// Cell-centred nodes of equal volume (seed 000 §3, seed 004).
+    #[default]
+    Cell,
+    /// Nodes on the boundary with partial volumes (seed 003 §3).
+    Boundary,
+}
+
+/// Horizon rule of a region.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum HorizonSpec {
+    /// δ = factor · Δ.
+    Factor(f64),
+    /// δ given, m.
+    Radius(f64),
+}
+
+/// `[[region]]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// Name.
+    pub name: String,
+    /// Min corner (default: the domain's), m.
+    #[serde(default)]
+    pub min: Option<Vec<f64>>,
+    /// Max corner (default: the domain's), m.
+    #[serde(default)]
+    pub max: Option<Vec<f64>>,
+    /// Node spacing Δ, m (or give `cells`).
+    #[serde(default)]
+    pub spacing: Option<f64>,
+    /// Cells per axis (or give `spacing`).
+    #[serde(default)]
+    pub cells: Option<Vec<usize>>,
+    /// Horizon rule.
+    pub horizon: HorizonSpec,
+    /// Material name (default: the only material).
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Initial temperature of this region, °C (overrides `[initial]`).
+    #[serde(default)]
+    pub initial: Option<f64>,
+}
+
+/// `[kernel]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KernelSpec {
+    /// Exponent p: 1 or 2.
+    #[serde(default = "default_p")]
+    pub p: u8,
+    /// Profile: constant, conical (alias triangular).
+    #[serde(default = "default_profile")]
+    pub profile: Profile,
+    /// Partial volumes: algorithm1 or all_or_nothing.
+    #[serde(default = "default_pv")]
+    pub partial_volume: PartialVolume,
+    /// Bond conductivity between materials: harmonic, lower, arithmetic.
+    #[serde(default)]
+    pub bond_rule: BondRule,
+    /// Normalisation: continuum (exact integral, default) or lattice (midpoint sum).
+    #[serde(default)]
+    pub calibration: Calibration,
+}
+
+fn default_p() -> u8 {
+    2
+}
+fn default_profile() -> Profile {
+    Profile::Constant
+}
+fn default_pv() -> PartialVolume {
+    PartialVolume::Algorithm1
+}
+
+impl Default for KernelSpec {
+    fn default() -> Self {
+        KernelSpec {
+            p: default_p(),
+            profile: default_profile(),
+            partial_volume: default_pv(),
+            bond_rule: BondRule::default(),
+            calibration: Calibration::default(),
+        }
+    }
+}
+
+/// `[boundary.<face>]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// free, temperature, insulated, flux or convection.
+    #[serde(rename = "type")]
+    pub kind: BoundaryKind,
+    /// temperature: nodal (default), mirror, naive; insulated: mirror (default) or free;
+    /// flux: mirror (default) or relation.
+    #[serde(default)]
+    pub method: Option<String>,
+    /// Temperature (°C) or flux into the body (W/m²): number or expression.
+    #[serde(default)]
+    pub value: Option<ValueSpec>,
+    /// Node layers held by a nodal temperature condition (default 1).
+    #[serde(default)]
+    pub layers: Option<f64>,
+    /// Film coefficient of a convection condition, W/(m²·K).
+    #[serde(default)]
+    pub h: Option<f64>,
+    /// Ambient temperature of a convection condition, °C.
+    #[serde(default)]
+    pub ambient: Option<ValueSpec>,
+}
+
+/// Kind of a boundary condition.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundaryKind {
+    /// No bonds leave the body.
+    Free,
+    /// Prescribed temperature.
+    Temperature,
+    /// Zero flux.
+    Insulated,
+    /// Prescribed flux into the body.
+    Flux,
+    /// Convection.
+    Convection,
+}
+
+/// `[initial]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// θ0: number or expression of x, y, z (default 0).
+    #[serde(default)]
+    pub value: Option<ValueSpec>,
+}
+
+/// `[source]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceSpec {
+    /// s(x, y, z, t), W/m³.
+    pub value: ValueSpec,
+}
+
+/// `[time]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// End time, s.
+    pub end: f64,
+    /// Time step, s (default: 0.95 of the stable bound).
+    #[serde(default)]
+    pub dt: Option<f64>,
+    /// euler or rk4 (default rk4).
+    #[serde(default = "default_integrator")]
+    pub integrator: Integrator,
+    /// Output times, s (default: the end time).
+    #[serde(default)]
+    pub outputs: Vec<f64>,
+}
+
+fn default_integrator() -> Integrator {
+    Integrator::Rk4
+}
+
+/// `[reference]`: a classical solution and where to compare.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// The analytical solution and its parameters.
+    pub solution: Reference,
+    /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`.
+    #[serde(default)]
+    pub line_y: Option<f64>,
+}
+
+/// A validated case: the model spec plus run settings.
+#[derive(Debug, Clone)]
+pub struct Case {
+    /// Where it came from.
+    pub path: PathBuf,
+    /// Title.
+    pub title: String,
+    /// The model.
+    pub spec: ModelSpec,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// User Δt, s.
+    pub dt: Option<f64>,
+    /// End time, s.
+    pub end: f64,
+    /// Output times, s, increasing.
+    pub outputs: Vec<f64>,
+    /// Reference, if any.
+    pub reference: Option<ReferenceSpec>,
+}
+
+impl Case {
+    /// Reads, parses and validates a case file.
+    pub fn load(path: &Path) -> Result<Case> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
+            file: path.to_path_buf(),
+            key: "-".into(),
+            message: format!("cannot read: {e}"),
+        })?;
+        Case::parse(&text, path)
+    }
+
+    /// Parses and validates case text; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Case> {
+        let file: CaseFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
+                .unwrap_or(0);
+            let msg = e.message().replace('\n', " ");
+            Error::Case {
+                file: path.to_path_buf(),
+                key: format!("line {line}"),
+                message: msg.trim().to_string(),
+            }
+        })?;
+        file.validate(path)
+    }
+}
+
+fn expr(v: &ValueSpec, path: &Path, key: &str) -> Result<Expr> {
+    match v {
+        ValueSpec::Number(x) if x.is_finite() => Ok(Expr::constant(*x)),
+        ValueSpec::Number(x) => Err(case_err(path, key, format!("must be finite, got {x}"))),
+        ValueSpec::Expr(s) => Expr::parse(s).map_err(|e| case_err(path, key, e.to_string())),
+    }
+}
+
+fn case_err(path: &Path, key: &str, message: impl Into<String>) -> Error {
+    Error::Case {
+        file: path.to_path_buf(),
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(case_err(path, key, format!("must be a positive number, got {v}")))
+    }
+}
+
+impl CaseFile {
+    fn validate(self, path: &Path) -> Result<Case> {
+        let err = |key: &str, m: String| case_err(path, key, m);
+        let dim = self.dimension;
+        if !(1..=3).contains(&dim) {
+            return Err(err("dimension", format!("must be 1, 2 or 3, got {dim}")));
+        }
+        let coords = |v: &[f64], key: &str| -> Result<[f64; 3]> {
+            if v.len() != dim {
+                return Err(err(key, format!("needs {dim} coordinates, got {}", v.len())));
+            }
+            let mut p = [0.0; 3];
+            for (a, x) in v.iter().enumerate() {
+                if !x.is_finite() {
+                    return Err(err(key, "coordinates must be finite".into()));
+                }
+                p[a] = *x;
+            }
+            Ok(p)
+        };
+        let dmin = coords(&self.domain.min, "domain.min")?;
+        let dmax = coords(&self.domain.max, "domain.max")?;
+        for a in 0..dim {
+            if dmax[a] <= dmin[a] {
+                return Err(err("domain.max", "must exceed domain.min on every axis".into()));
+            }
+        }
+        let tau = match dim {
+            1 => {
+                if self.domain.thickness.is_some() {
+                    return Err(err("domain.thickness", "is for 2D; a 1D bar takes domain.area".into()));
+                }
+                positive(path, "domain.area", self.domain.area.unwrap_or(1.0))?
+            }
+            2 => {
+                if self.domain.area.is_some() {
+                    return Err(err("domain.area", "is for 1D; a 2D body takes domain.thickness".into()));
+                }
+                positive(path, "domain.thickness", self.domain.thickness.unwrap_or(1.0))?
+            }
+            _ => {
+                if self.domain.area.is_some() || self.domain.thickness.is_some() {
+                    return Err(err("domain", "a 3D body takes neither area nor thickness".into()));
+                }
+                1.0
+            }
+        };
+        if self.material.is_empty() {
+            return Err(err("material", "define at least one [material.<name>]".into()));
+        }
+        let names: Vec<&String> = self.material.keys().collect();
+        let mut materials = Vec::new();
+        for (name, m) in &self.material {
+            positive(path, &format!("material.{name}.conductivity"), m.conductivity)?;
+            positive(path, &format!("material.{name}.density"), m.density)?;
+            positive(path, &format!("material.{name}.specific_heat"), m.specific_heat)?;
+            materials.push(*m);
+        }
+        if self.region.is_empty() {
+            return Err(err("region", "define at least one [[region]]".into()));
+        }
+        let mut regions = Vec::new();
+        let mut per_region_initial = Vec::new();
+        for (r, reg) in self.region.iter().enumerate() {
+            let key = |k: &str| format!("region[{r}].{k}");
+            let rmin = match &reg.min {
+                Some(v) => coords(v, &key("min"))?,
+                None => dmin,
+            };
+            let rmax = match &reg.max {
+                Some(v) => coords(v, &key("max"))?,
+                None => dmax,
+            };
+            for a in 0..dim {
+                if rmax[a] <= rmin[a] {
+                    return Err(err(&key("max"), "must exceed min on every axis".into()));
+                }
+            }
+            let mut cells = [1usize; 3];
+            match (&reg.spacing, &reg.cells) {
+                (Some(_), Some(_)) => return Err(err(&key("spacing"), "give spacing or cells, not both".into())),
+                (None, None) => return Err(err(&key("spacing"), "missing: give spacing or cells".into())),
+                (Some(h), None) => {
+                    let h = positive(path, &key("spacing"), *h)?;
+                    for a in 0..dim {
+                        let n = (rmax[a] - rmin[a]) / h;
+                        let nr = n.round();
+                        if nr < 1.0 || (n - nr).abs() > 1e-6 * n {
+                            return Err(err(
+                                &key("spacing"),
+                                format!("{h} does not divide the region's side {} into whole cells", rmax[a] - rmin[a]),
+                            ));
+                        }
+                        cells[a] = nr as usize;
+                    }
+                }
+                (None, Some(c)) => {
+                    if c.len() != dim || c.contains(&0) {
+                        return Err(err(&key("cells"), format!("needs {dim} positive counts")));
+                    }
+                    cells[..dim].copy_from_slice(c);
+                }
+            }
+            let horizon = match reg.horizon {
+                HorizonSpec::Factor(n) => HorizonRule::Factor(positive(path, &key("horizon.factor"), n)?),
+                HorizonSpec::Radius(d) => HorizonRule::Radius(positive(path, &key("horizon.radius"), d)?),
+            };
+            let material = match &reg.material {
+                Some(m) => names
+                    .iter()
+                    .position(|n| *n == m)
+                    .ok_or_else(|| err(&key("material"), format!("unknown material `{m}`; defined: {names:?}")))?,
+                None if names.len() == 1 => 0,
+                None => return Err(err(&key("material"), "several materials are defined: name one".into())),
+            };
+            per_region_initial.push(reg.initial);
+            regions.push(BoxRegion {
+                name: reg.name.clone(),
+                min: rmin,
+                max: rmax,
+                cells,
+                horizon,
+                material: material as u16,
+            });
+        }
+        if self.kernel.p != 1 && self.kernel.p != 2 {
+            return Err(err("kernel.p", format!("must be 1 or 2, got {}", self.kernel.p)));
+        }
+        let kernel = Kernel {
+            p: self.kernel.p,
+            profile: self.kernel.profile,
+            partial_volume: self.kernel.partial_volume,
+            calibration: self.kernel.calibration,
+        };
+        let mut faces = vec![FaceBc::Free; 6];
+        for (name, b) in &self.boundary {
+            let key = |k: &str| format!("boundary.{name}.{k}");
+            let f = FACE_NAMES
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| err(&format!("boundary.{name}"), format!("unknown face; use one of {:?}", &FACE_NAMES[..2 * dim])))?;
+            if f >= 2 * dim {
+                return Err(err(&format!("boundary.{name}"), format!("a {dim}D case has faces {:?}", &FACE_NAMES[..2 * dim])));
+            }
+            let value = |required: bool| -> Result<Option<Expr>> {
+                match &b.value {
+                    Some(v) => Ok(Some(expr(v, path, &key("value"))?)),
+                    None if required => Err(err(&key("value"), "missing".into())),
+                    None => Ok(None),
+                }
+            };
+            let method = b.method.as_deref();
+            let bad_method = |allowed: &str| err(&key("method"), format!("`{}` is not one of {allowed}", method.unwrap_or("")));
+            let unused = |k: &str, present: bool| -> Result<()> {
+                if present {
+                    Err(err(&key(k), format!("does not apply to type = \"{:?}\"", b.kind).to_lowercase()))
+                } else {
+                    Ok(())
+                }
+            };
+            unused("layers", b.layers.is_some() && !(b.kind == BoundaryKind::Temperature && matches!(method, None | Some("nodal"))))?;
+            unused("h", b.h.is_some() && b.kind != BoundaryKind::Convection)?;
+            unused("ambient", b.ambient.is_some() && b.kind != BoundaryKind::Convection)?;
+            faces[f] = match b.kind {
+                BoundaryKind::Free => {
+                    unused("value", b.value.is_some())?;
+                    FaceBc::Free
+                }
+                BoundaryKind::Temperature => {
+                    let v = value(true)?.expect("required");
+                    match method {
+                        None | Some("nodal") => {
+                            let layers = b.layers.unwrap_or(1.0);
+                            if !(layers >= 1.0 && layers.fract() == 0.0) {
+                                return Err(err(&key("layers"), format!("must be a whole number >= 1, got {layers}")));
+                            }
+                            FaceBc::NodalTemperature { value: v, layers }
+                        }
+                        Some("mirror") => FaceBc::LayerTemperature { value: v, layer: Layer::Mirror },
+                        Some("naive") => FaceBc::LayerTemperature { value: v, layer: Layer::Naive },
+                        _ => return Err(bad_method("nodal, mirror, naive")),
+                    }
+                }
+                BoundaryKind::Insulated => {
+                    unused("value", b.value.is_some())?;
+                    match method {
+                        None | Some("mirror") => FaceBc::LayerInsulated,
+                        Some("free") => FaceBc::Free,
+                        _ => return Err(bad_method("mirror, free")),
+                    }
+                }
+                BoundaryKind::Flux => {
+                    let v = value(true)?.expect("required");
+                    match method {
+                        None | Some("mirror") => FaceBc::LayerFlux { value: v },
+                        Some("relation") => FaceBc::RelationFlux { value: v },
+                        _ => return Err(bad_method("mirror, relation")),
+                    }
+                }
+                BoundaryKind::Convection => {
+                    unused("value", b.value.is_some())?;
+                    let h = positive(path, &key("h"), b.h.ok_or_else(|| err(&key("h"), "missing".into()))?)?;
+                    let amb = b.ambient.as_ref().ok_or_else(|| err(&key("ambient"), "missing".into()))?;
+                    FaceBc::Convection {
+                        h,
+                        ambient: expr(amb, path, &key("ambient"))?,
+                    }
+                }
+            };
+        }
+        let base = match &self.initial.value {
+            Some(v) => expr(v, path, "initial.value")?,
+            None => Expr::constant(0.0),
+        };
+        if !base.is_time_independent() {
+            return Err(err("initial.value", "must not depend on t".into()));
+        }
+        let initial = if per_region_initial.iter().any(Option::is_some) {
+            if !base.is_uniform() {
+                return Err(err("region.initial", "cannot be combined with an [initial] expression of x, y, z".into()));
+            }
+            let b0 = base.eval(0.0, 0.0, 0.0, 0.0);
+            Initial::PerRegion(per_region_initial.iter().map(|v| v.unwrap_or(b0)).collect())
+        } else {
+            Initial::Field(base)
+        };
+        let source = match &self.source {
+            Some(s) => Some(expr(&s.value, path, "source.value")?),
+            None => None,
+        };
+        let end = positive(path, "time.end", self.time.end)?;
+        if let Some(dt) = self.time.dt {
+            positive(path, "time.dt", dt)?;
+        }
+        let mut outputs = self.time.outputs.clone();
+        if outputs.is_empty() {
+            outputs.push(end);
+        }
+        for (k, &t) in outputs.iter().enumerate() {
+            if !(t > 0.0 && t <= end * (1.0 + 1e-12)) {
+                return Err(err(&format!("time.outputs[{k}]"), format!("{t} is not in (0, time.end = {end}]")));
+            }
+            if k > 0 && t <= outputs[k - 1] {
+                return Err(err(&format!("time.outputs[{k}]"), "output times must increase".into()));
+            }
+        }
+        let geometry = BoxGeometry {
+            dim,
+            tau,
+            min: dmin,
+            max: dmax,
+            boundary_placement: self.domain.placement == Placement::Boundary,
+            regions,
+        };
+        geometry.validate().map_err(|e| match e {
+            Error::Model { key, message } => err(&key, message),
+            other => other,
+        })?;
+        Ok(Case {
+            path: path.to_path_buf(),
+            title: self.title,
+            spec: ModelSpec {
+                geometry,
+                materials,
+                kernel,
+                bond_rule: self.kernel.bond_rule,
+                faces,
+                source,
+                initial,
+            },
+            integrator: self.time.integrator,
+            dt: self.time.dt,
+            end,
+            outputs,
+            reference: self.reference,
+        })
+    }
+}

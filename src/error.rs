@@ -1,0 +1,73 @@
+//! Typed errors of the library; the CLI turns them into one line each.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong inside peritherm.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A case file that cannot be read, parsed or validated.
+    #[error("{file}: {key}: {message}")]
+    Case {
+        /// The case file.
+        file: PathBuf,
+        /// The offending key, dotted (e.g. `time.dt`).
+        key: String,
+        /// What is wrong and what is expected.
+        message: String,
+    },
+    /// A model that is inconsistent although each key was valid.
+    #[error("{key}: {message}")]
+    Model {
+        /// The key or component that causes it.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An expression string that does not parse or evaluate.
+    #[error("expression `{expr}`: {message}")]
+    Expr {
+        /// The expression text.
+        expr: String,
+        /// The reason.
+        message: String,
+    },
+    /// A time step above the stability bound of formulation §4.
+    #[error("time.dt = {dt:e} s exceeds the stable bound {bound:e} s of the {integrator} integrator (formulation §4); use time.dt <= {bound:e} or omit it")]
+    UnstableDt {
+        /// The requested step, s.
+        dt: f64,
+        /// The largest stable step, s.
+        bound: f64,
+        /// Integrator name.
+        integrator: &'static str,
+    },
+    /// The state became non-finite during a run.
+    #[error("temperature became non-finite at node {node} (t = {time:e} s); check conductivity, dt and boundary values")]
+    NonFinite {
+        /// First bad node (body index).
+        node: usize,
+        /// Simulation time, s.
+        time: f64,
+    },
+    /// Output could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+}
+
+/// Result alias for the library.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Shorthand for a [`Error::Model`].
+    pub fn model(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Model {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,28 @@
+//! peritherm: transient heat conduction with dual-horizon peridynamics.
+//!
+//! The numerics follow `formulation.md` (the project's contract), which reconciles
+//! Bobaru & Duangpanya 2010 (seed 000), 2012 (seed 003), the axisymmetric/phase-change
+//! paper (seed 001) and Wang, Oterkus & Oterkus's dual-horizon thermal diffusion (seed 004).
+//!
+//! Flow: [`case`] (TOML) → [`model::ModelSpec`] → [`cloud`] → [`neighbors`] →
+//! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.
+#![warn(missing_docs)]
+
+pub mod analytic;
+pub mod bc;
+pub mod case;
+pub mod cloud;
+pub mod error;
+pub mod expr;
+pub mod kernel;
+pub mod material;
+pub mod math;
+pub mod model;
+pub mod neighbors;
+pub mod operator;
+pub mod output;
+pub mod report;
+pub mod run;
+pub mod solve;
+
+pub use error::{Error, Result};

@@ -1,0 +1,117 @@
+//! The `peritherm` command line.
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use peritherm::case::Case;
+use peritherm::model::Model;
+use peritherm::run::run_case;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "peritherm", version, about = "Transient heat conduction with dual-horizon peridynamics")]
+struct Cli {
+    /// Worker threads (default: all cores).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case and write field_<k>.csv and run.json into --out.
+    Run {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Validate a case and print its size and stable time step without running it.
+    Check {
+        /// The case file (TOML).
+        case: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match real_main(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let msg = format!("{e:#}").replace('\n', " ");
+            eprintln!("error: {msg}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main(cli: Cli) -> anyhow::Result<()> {
+    if let Some(n) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("--threads")?;
+    }
+    match cli.command {
+        Command::Run { case, out, quiet } => {
+            let case = Case::load(&case)?;
+            let bar = ProgressBar::new(0);
+            if quiet || !std::io::stderr().is_terminal() {
+                bar.set_draw_target(ProgressDrawTarget::hidden());
+            }
+            bar.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}")
+                    .expect("valid template"),
+            );
+            let summary = run_case(&case, &out, |done, total| {
+                bar.set_length(total);
+                bar.set_position(done);
+            })?;
+            bar.finish_and_clear();
+            println!(
+                "{}: {} nodes, {} bonds, {} steps of {:.3e} s in {:.2} s -> {}",
+                case.path.display(),
+                summary.nodes,
+                summary.bonds,
+                summary.steps,
+                summary.dt,
+                summary.wall_seconds,
+                out.display()
+            );
+            for c in &summary.reference {
+                println!(
+                    "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
+                    c.time, c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line
+                );
+            }
+            Ok(())
+        }
+        Command::Check { case } => {
+            let case = Case::load(&case)?;
+            let model = Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
+            let bound = case.integrator.stable_dt(&model);
+            println!(
+                "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
+                case.path.display(),
+                model.cloud.n_body,
+                model.cloud.n_fictitious(),
+                model.horizons.n_bonds(),
+                case.integrator.name(),
+                bound
+            );
+            if let Some(dt) = case.dt {
+                if dt > bound {
+                    anyhow::bail!("{}: time.dt: {dt:e} s exceeds the stable bound {bound:e} s", case.path.display());
+                }
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! A ready-to-integrate model: cloud, bonds, conductance, capacities and boundary.
+
+use crate::bc::{Boundary, BoundaryInput, FaceBc};
+use crate::cloud::{BoxGeometry, Cloud};
+use crate::error::{Error, Result};
+use crate::expr::Expr;
+use crate::kernel::{Kernel, PartialVolume};
+use crate::material::{BondRule, Material};
+use crate::neighbors::Horizons;
+use crate::operator::{directed_weights, Conductance};
+
+/// Initial temperature field.
+#[derive(Debug, Clone)]
+pub enum Initial {
+    /// θ0(x, y, z), °C.
+    Field(Expr),
+    /// One value per region, °C.
+    PerRegion(Vec<f64>),
+}
+
+/// Everything that defines a model, independent of any file format.
+#[derive(Debug, Clone)]
+pub struct ModelSpec {
+    /// The built-in geometry.
+    pub geometry: BoxGeometry,
+    /// Materials, indexed by the regions' material index.
+    pub materials: Vec<Material>,
+    /// Kernel.
+    pub kernel: Kernel,
+    /// Interface rule for bonds between materials.
+    pub bond_rule: BondRule,
+    /// Conditions on the six faces (x_min … z_max).
+    pub faces: Vec<FaceBc>,
+    /// Volumetric heat source s(x, y, z, t), W/m³.
+    pub source: Option<Expr>,
+    /// Initial temperature.
+    pub initial: Initial,
+}
+
+/// An assembled model.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Nodes (body first, then fictitious).
+    pub cloud: Cloud,
+    /// Directed neighbour lists.
+    pub horizons: Horizons,
+    /// Symmetric pair conductance, W/K.
+    pub conductance: Conductance,
+    /// Conductivity per node, W/(m·K).
+    pub conductivity: Vec<f64>,
+    /// Volumetric heat capacity ρc per node, J/(m³·K).
+    pub capacity: Vec<f64>,
+    /// 1 / (V_i ρc_i) per body node, K/J.
+    pub inv_heat_capacity: Vec<f64>,
+    /// Boundary conditions and loads.
+    pub boundary: Boundary,
+    /// Initial temperature of every node, °C.
+    pub theta0: Vec<f64>,
+}
+
+impl Model {
+    /// Builds cloud, bonds, conductance and boundary from a spec.
+    pub fn build(spec: &ModelSpec) -> Result<Model> {
+        for (m, mat) in spec.materials.iter().enumerate() {
+            for (name, v) in [
+                ("conductivity", mat.conductivity),
+                ("density", mat.density),
+                ("specific_heat", mat.specific_heat),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(Error::model(format!("material[{m}].{name}"), format!("must be a positive number, got {v}")));
+                }
+            }
+        }
+        let g = &spec.geometry;
+        let mut mask = 0u8;
+        for (f, bc) in spec.faces.iter().enumerate() {
+            if bc.needs_layer() {
+                mask |= 1 << f;
+            }
+        }
+        let band = match spec.kernel.partial_volume {
+            PartialVolume::AllOrNothing => 0.0,
+            PartialVolume::Algorithm1 => 0.5,
+        };
+        let layer = g
+            .regions
+            .iter()
+            .map(|r| {
+                let h = (r.max[0] - r.min[0]) / r.cells[0] as f64;
+                r.horizon.horizon(h)
+            })
+            .fold(0.0, f64::max)
+            + band
+                * g.regions
+                    .iter()
+                    .map(|r| (r.max[0] - r.min[0]) / r.cells[0] as f64)
+                    .fold(0.0, f64::max);
+        let cloud = g.generate(mask, layer)?;
+        let mat = |i: usize| spec.materials[cloud.material[i] as usize];
+        let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
+        let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
+        let horizons = Horizons::build(&cloud, &spec.kernel);
+        let weights = directed_weights(&cloud, &horizons, &spec.kernel, &conductivity, spec.bond_rule);
+        let conductance = Conductance::assemble(&cloud, &horizons, &weights);
+        let needs_micro = spec.faces.iter().any(|f| matches!(f, FaceBc::RelationFlux { .. })) && cloud.dim > 1;
+        let micro: Vec<f64> = if needs_micro {
+            (0..horizons.len())
+                .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
+                .map(|(i, b)| 2.0 * weights[b] / cloud.volume[i])
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let boundary = Boundary::build(BoundaryInput {
+            cloud: &cloud,
+            faces: spec.faces.clone(),
+            conductivity: &conductivity,
+            capacity: &capacity,
+            micro: if needs_micro { Some((&horizons, &micro)) } else { None },
+            source: spec.source.clone(),
+        });
+        let inv_heat_capacity = (0..cloud.n_body).map(|i| 1.0 / (cloud.volume[i] * capacity[i])).collect();
+        let mut theta0: Vec<f64> = match &spec.initial {
+            Initial::Field(e) => cloud.pos.iter().map(|p| e.eval(p.x, p.y, p.z, 0.0)).collect(),
+            Initial::PerRegion(v) => cloud.region.iter().map(|&r| v[r as usize]).collect(),
+        };
+        if let Some(i) = theta0.iter().position(|v| !v.is_finite()) {
+            return Err(Error::model("initial", format!("initial temperature is not finite at node {i}")));
+        }
+        boundary.apply(&cloud, &mut theta0, 0.0);
+        Ok(Model {
+            cloud,
+            horizons,
+            conductance,
+            conductivity,
+            capacity,
+            inv_heat_capacity,
+            boundary,
+            theta0,
+        })
+    }
+
+    /// Total thermal energy of the body, Σ V_i ρc_i θ_i, J (relative to 0 °C).
+    pub fn energy(&self, theta: &[f64]) -> f64 {
+        (0..self.cloud.n_body)
+            .map(|i| self.cloud.volume[i] * self.capacity[i] * theta[i])
+            .sum()
+    }
+
+    /// Gershgorin bound on the largest eigenvalue of the free-node system, 1/s (formulation §4).
+    pub fn lambda_max(&self) -> f64 {
+        let loads = self.boundary.load_diagonal(self.cloud.n_body);
+        (0..self.cloud.n_body)
+            .filter(|&i| !self.boundary.driven[i])
+            .map(|i| 2.0 * self.conductance.diag[i] * self.inv_heat_capacity[i] + loads[i])
+            .fold(0.0, f64::max)
+    }
+}

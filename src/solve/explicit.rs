@@ -1,0 +1,211 @@
+//! Explicit time integration: forward Euler (seeds 001, 004) and classical RK4 (seeds 000, 003).
+//!
+//! The rate of a free body node is `Σ_j K_ij (θ_j − θ_i)/(V_i ρc_i)` plus loads; driven nodes
+//! (Dirichlet, flux relations) and fictitious nodes are set by the boundary at every stage.
+//! Buffers are allocated once; the bond sum is a parallel gather.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Explicit integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Forward Euler, stable for Δt ≤ 2/λ_max.
+    Euler,
+    /// Classical fourth-order Runge–Kutta, stable for Δt ≤ 2.78/λ_max.
+    Rk4,
+}
+
+impl Integrator {
+    /// Name for messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Euler => "euler",
+            Integrator::Rk4 => "rk4",
+        }
+    }
+    /// Stability-region extent on the negative real axis (formulation §4).
+    pub fn stability(&self) -> f64 {
+        match self {
+            Integrator::Euler => 2.0,
+            Integrator::Rk4 => 2.78,
+        }
+    }
+    /// Largest stable step for a model, s.
+    pub fn stable_dt(&self, model: &Model) -> f64 {
+        let l = model.lambda_max();
+        if l > 0.0 {
+            self.stability() / l
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// Summary of a run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunStats {
+    /// Time steps taken.
+    pub steps: u64,
+}
+
+/// Chooses the step: the user's (checked against the bound) or 0.95 of the bound.
+pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Result<f64> {
+    let bound = integrator.stable_dt(model);
+    match user {
+        Some(dt) if dt > bound => Err(Error::UnstableDt {
+            dt,
+            bound,
+            integrator: integrator.name(),
+        }),
+        Some(dt) => Ok(dt),
+        None if bound.is_finite() => Ok(0.95 * bound),
+        None => Err(Error::model("time.dt", "every node is driven; give time.dt explicitly")),
+    }
+}
+
+/// Number of steps from `t0` to each output time with steps no longer than `dt`.
+pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
+    let mut t = t0;
+    let mut n = 0;
+    for &to in outputs {
+        n += ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+        t = to;
+    }
+    n
+}
+
+fn rates(model: &Model, theta: &[f64], t: f64, out: &mut [f64]) {
+    let k = &model.conductance;
+    let inv = &model.inv_heat_capacity;
+    let driven = &model.boundary.driven;
+    out.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, o)| {
+        *o = if driven[i] { 0.0 } else { k.row_flow(i, theta) * inv[i] };
+    });
+    if model.boundary.has_loads() {
+        model
+            .boundary
+            .add_loads(&model.cloud, &model.capacity, theta, t, out);
+        for (o, &d) in out.iter_mut().zip(driven) {
+            if d {
+                *o = 0.0;
+            }
+        }
+    }
+}
+
+/// Explicit integrator state with preallocated buffers.
+pub struct Explicit<'a> {
+    model: &'a Model,
+    integrator: Integrator,
+    k: [Vec<f64>; 4],
+    stage: Vec<f64>,
+}
+
+impl<'a> Explicit<'a> {
+    /// Allocates the buffers for a model.
+    pub fn new(model: &'a Model, integrator: Integrator) -> Self {
+        let nb = model.cloud.n_body;
+        let stages = match integrator {
+            Integrator::Euler => 1,
+            Integrator::Rk4 => 4,
+        };
+        let k = std::array::from_fn(|s| if s < stages { vec![0.0; nb] } else { Vec::new() });
+        Explicit {
+            model,
+            integrator,
+            k,
+            stage: vec![0.0; model.cloud.len()],
+        }
+    }
+
+    /// Advances `theta` (all nodes) from t to t + h, constraints included.
+    pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        let m = self.model;
+        let nb = m.cloud.n_body;
+        match self.integrator {
+            Integrator::Euler => {
+                rates(m, theta, t, &mut self.k[0]);
+                theta[..nb]
+                    .par_iter_mut()
+                    .with_min_len(4096)
+                    .zip(&self.k[0])
+                    .for_each(|(y, k)| *y += h * k);
+            }
+            Integrator::Rk4 => {
+                let [k1, k2, k3, k4] = &mut self.k;
+                let stage = &mut self.stage;
+                rates(m, theta, t, k1);
+                stage.copy_from_slice(theta);
+                axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k1);
+                m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
+                rates(m, stage, t + 0.5 * h, k2);
+                axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k2);
+                m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
+                rates(m, stage, t + 0.5 * h, k3);
+                axpy(&mut stage[..nb], &theta[..nb], h, k3);
+                m.boundary.apply(&m.cloud, stage, t + h);
+                rates(m, stage, t + h, k4);
+                let h6 = h / 6.0;
+                theta[..nb]
+                    .par_iter_mut()
+                    .with_min_len(4096)
+                    .enumerate()
+                    .for_each(|(i, y)| *y += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]));
+            }
+        }
+        m.boundary.apply(&m.cloud, theta, t + h);
+    }
+
+    /// Integrates from `t0` through each output time, calling `on_output(k, t, θ)` there and
+    /// `progress(steps)` now and then. Steps never exceed `dt` and land on the output times.
+    pub fn run(
+        &mut self,
+        theta: &mut [f64],
+        t0: f64,
+        dt: f64,
+        outputs: &[f64],
+        mut on_output: impl FnMut(usize, f64, &[f64]) -> Result<()>,
+        mut progress: impl FnMut(u64),
+    ) -> Result<RunStats> {
+        let mut t = t0;
+        let mut stats = RunStats::default();
+        for (k, &to) in outputs.iter().enumerate() {
+            let n = ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+            let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
+            for s in 0..n {
+                let tn = t + s as f64 * h;
+                self.step(theta, tn, h);
+                stats.steps += 1;
+                if stats.steps % 256 == 0 {
+                    progress(stats.steps);
+                    if stats.steps % 4096 == 0 {
+                        check_finite(theta, self.model.cloud.n_body, tn + h)?;
+                    }
+                }
+            }
+            t = to;
+            check_finite(theta, self.model.cloud.n_body, t)?;
+            on_output(k, t, theta)?;
+        }
+        progress(stats.steps);
+        Ok(stats)
+    }
+}
+
+fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
+    out.par_iter_mut()
+        .with_min_len(4096)
+        .enumerate()
+        .for_each(|(i, o)| *o = y[i] + a * k[i]);
+}
+
+fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
+    match theta[..nb].iter().position(|v| !v.is_finite()) {
+        Some(node) => Err(Error::NonFinite { node, time: t }),
+        None => Ok(()),
+    }
+}

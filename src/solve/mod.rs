@@ -1,0 +1,3 @@
+//! Time integration of formulation eq (1).
+
+pub mod explicit;
