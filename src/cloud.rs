@@ -378,6 +378,7 @@ mod tests {
     fn rejects_gaps_and_overlaps() {
         let mut g = plate(false, 1.0);
         g.regions[1].min[0] = 0.1;
+        g.regions[1].cells[0] = 8;
         assert!(g.validate().unwrap_err().to_string().contains("tile"));
         let mut g = plate(false, 1.0);
         g.regions[1].min[0] = -0.1;

@@ -1,0 +1,209 @@
+//! Exact invariants: energy conservation, symmetry of K, linear fields, serial == parallel,
+//! and the explicit stability bound.
+
+use peritherm::case::Case;
+use peritherm::model::Model;
+use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use std::path::Path;
+
+/// A two-region dual-horizon plate 2 × 1: k = Δ1/Δ2 = 0.5, m = δ1/δ2 = 2/3 (so neither
+/// spacing nor horizon is uniform), free (insulated) surfaces.
+fn dual_horizon_case(faces: &str, calibration: &str) -> Case {
+    let text = format!(
+        r#"
+dimension = 2
+[domain]
+min = [0.0, 0.0]
+max = [2.0, 1.0]
+thickness = 0.1
+[[region]]
+name = "fine"
+max = [0.8, 1.0]
+spacing = 0.025
+horizon = {{ factor = 4.0 }}
+[[region]]
+name = "coarse"
+min = [0.8, 0.0]
+spacing = 0.05
+horizon = {{ factor = 3.0 }}
+[material.m]
+conductivity = 2.0
+density = 300.0
+specific_heat = 0.5
+[kernel]
+p = 1
+calibration = "{calibration}"
+{faces}
+[initial]
+value = "sin(7*x) + 3*cos(5*y) + x*y"
+[time]
+end = 1.0
+integrator = "euler"
+"#
+    );
+    Case::parse(&text, Path::new("dual_horizon.toml")).unwrap()
+}
+
+/// Energy Σ V ρc θ stays constant over 1000 Euler steps on an insulated, non-uniform,
+/// dual-horizon cloud. Tolerance 1e-12 relative: the bond sum cancels pairwise (K_ij = K_ji
+/// bit for bit), leaving only summation round-off.
+#[test]
+fn energy_is_conserved_with_dual_horizon() {
+    for integ in [Integrator::Euler, Integrator::Rk4] {
+        let case = dual_horizon_case("", "continuum");
+        let model = Model::build(&case.spec).unwrap();
+        // a twentieth of the stable step, so that the field still varies after 1000 steps
+        let dt = choose_dt(&model, integ, None).unwrap() / 20.0;
+        let mut theta = model.theta0.clone();
+        let e0 = model.energy(&theta);
+        let mut st = Explicit::new(&model, integ);
+        for s in 0..1000 {
+            st.step(&mut theta, s as f64 * dt, dt);
+        }
+        let e1 = model.energy(&theta);
+        let spread = theta.iter().cloned().fold(f64::MIN, f64::max) - theta.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(spread > 0.1, "the field must still vary for the test to mean anything");
+        assert!(((e1 - e0) / e0).abs() <= 1e-12, "{integ:?}: drift {}", (e1 - e0) / e0);
+    }
+}
+
+/// K_ij == K_ji exactly for every body pair, with variable spacing and horizon, and the
+/// directed bonds really are asymmetric (some j ∈ H_i with i ∉ H_j).
+#[test]
+fn conductance_is_symmetric_and_bonds_are_directed() {
+    let model = Model::build(&dual_horizon_case("", "lattice").spec).unwrap();
+    let k = &model.conductance;
+    let h = &model.horizons;
+    let mut one_way = 0;
+    for i in 0..k.n_rows() {
+        for b in k.offsets[i]..k.offsets[i + 1] {
+            let j = k.cols[b] as usize;
+            assert_eq!(k.vals[b], k.get(j, i), "K[{i},{j}]");
+            assert!(k.vals[b] > 0.0);
+        }
+        for b in h.row(i) {
+            let j = h.targets[b] as usize;
+            if !h.targets[h.row(j)].contains(&(i as u32)) {
+                one_way += 1;
+            }
+        }
+    }
+    assert!(one_way > 0, "a dual-horizon cloud must have one-way bonds");
+}
+
+/// A linear field produces no flow at nodes whose horizon is full and uniform (tolerance
+/// 1e-9 of the flow scale: round-off over a symmetric lattice sum).
+#[test]
+fn linear_field_is_steady_in_the_bulk() {
+    let case = dual_horizon_case("", "continuum");
+    let model = Model::build(&case.spec).unwrap();
+    let c = &model.cloud;
+    let theta: Vec<f64> = c.pos.iter().map(|p| 3.0 * p.x - 2.0 * p.y + 1.0).collect();
+    let mut flow = vec![0.0; c.n_body];
+    model.conductance.apply(&theta, &mut flow);
+    let scale = model.conductance.diag.iter().cloned().fold(0.0, f64::max) * 0.2;
+    let mut checked = 0;
+    for i in 0..c.n_body {
+        let p = c.pos[i];
+        let reach = c.horizon[i] + c.spacing[i];
+        // no bond of i reaches the other region or a free surface (largest reach 0.2)
+        let far_from_interface = (p.x - 0.8).abs() > 0.2 + reach;
+        let inside = p.x > reach && p.x < 2.0 - reach && p.y > reach && p.y < 1.0 - reach;
+        if inside && far_from_interface {
+            assert!(flow[i].abs() < 1e-9 * scale, "node {i} at {p}: {}", flow[i]);
+            checked += 1;
+        }
+    }
+    assert!(checked > 10);
+}
+
+/// With mirrored fictitious layers (Dirichlet on x, insulated on y) a linear field in x is
+/// steady at every body node, including those at the faces and corners (same tolerance).
+#[test]
+fn mirror_layers_keep_a_linear_field_steady_everywhere() {
+    let faces = r#"
+[boundary.x_min]
+type = "temperature"
+method = "mirror"
+value = 1.0
+[boundary.x_max]
+type = "temperature"
+method = "mirror"
+value = 7.0
+[boundary.y_min]
+type = "insulated"
+[boundary.y_max]
+type = "insulated"
+"#;
+    let case = dual_horizon_case(faces, "lattice");
+    let mut spec = case.spec.clone();
+    spec.geometry.regions.truncate(1);
+    spec.geometry.regions[0].max[0] = 2.0;
+    spec.geometry.regions[0].cells[0] = 80;
+    spec.initial = peritherm::model::Initial::Field(peritherm::expr::Expr::parse("1 + 3*x").unwrap());
+    let model = Model::build(&spec).unwrap();
+    let mut theta = model.theta0.clone();
+    model.boundary.apply(&model.cloud, &mut theta, 0.0);
+    let mut flow = vec![0.0; model.cloud.n_body];
+    model.conductance.apply(&theta, &mut flow);
+    let scale = model.conductance.diag.iter().cloned().fold(0.0, f64::max) * 0.1;
+    for (i, f) in flow.iter().enumerate() {
+        assert!(f.abs() < 1e-9 * scale, "node {i} at {}: {f}", model.cloud.pos[i]);
+    }
+}
+
+/// The parallel gather gives bit-identical results to the serial loop.
+#[test]
+fn serial_and_parallel_products_agree_exactly() {
+    let model = Model::build(&dual_horizon_case("", "lattice").spec).unwrap();
+    let mut a = vec![0.0; model.cloud.n_body];
+    let mut b = a.clone();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    pool.install(|| model.conductance.apply(&model.theta0, &mut a));
+    model.conductance.apply_serial(&model.theta0, &mut b);
+    assert_eq!(a, b);
+}
+
+/// The Gershgorin bound of formulation §4 is safe and not far from the truth: Euler at the
+/// bound stays bounded; Euler at 1.2× the true limit 2/λ_max (power iteration) blows up;
+/// a user Δt above the bound is refused with the bound in the message.
+#[test]
+fn time_step_bound() {
+    let model = Model::build(&dual_horizon_case("", "continuum").spec).unwrap();
+    let n = model.cloud.n_body;
+    // power iteration on A = M⁻¹ L (free nodes), shifted to its largest magnitude
+    let mut v: Vec<f64> = (0..n).map(|i| if i % 2 == 0 { 1.0 } else { -0.7 }).collect();
+    let mut lambda = 0.0;
+    let mut w = vec![0.0; n];
+    for _ in 0..3000 {
+        model.conductance.apply(&v, &mut w);
+        let mut norm = 0.0;
+        for i in 0..n {
+            w[i] *= -model.inv_heat_capacity[i];
+            norm += w[i] * w[i];
+        }
+        let norm = norm.sqrt();
+        let vn = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        lambda = norm / vn;
+        for i in 0..n {
+            v[i] = w[i] / norm;
+        }
+    }
+    let bound = Integrator::Euler.stable_dt(&model);
+    let exact = 2.0 / lambda;
+    assert!(bound <= exact * (1.0 + 1e-6), "bound {bound} vs exact {exact}");
+    assert!(bound > 0.25 * exact, "bound {bound} is too pessimistic vs {exact}");
+    let amplitude = |dt: f64| {
+        let mut theta = model.theta0.clone();
+        let mut st = Explicit::new(&model, Integrator::Euler);
+        for s in 0..400 {
+            st.step(&mut theta, s as f64 * dt, dt);
+        }
+        theta[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let a0 = model.theta0[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(amplitude(bound) <= a0 * (1.0 + 1e-9));
+    assert!(amplitude(1.2 * exact) > 1e3 * a0);
+    let err = choose_dt(&model, Integrator::Euler, Some(2.0 * bound)).unwrap_err().to_string();
+    assert!(err.contains("exceeds the stable bound"), "{err}");
+}
