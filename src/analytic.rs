@@ -87,7 +87,11 @@ pub enum Reference {
 
 /// Number of series terms so that e^(−α λ_n² t) < e^(−40) beyond, with λ_n = c n.
 fn terms(alpha: f64, t: f64, c: f64) -> usize {
-    let n = if t > 0.0 { (40.0 / (alpha * t)).sqrt() / c } else { f64::INFINITY };
+    let n = if t > 0.0 {
+        (40.0 / (alpha * t)).sqrt() / c
+    } else {
+        f64::INFINITY
+    };
     (n.ceil() as usize + 2).clamp(200, 200_000)
 }
 
@@ -232,7 +236,11 @@ mod tests {
             right: 0.0,
             initial: 100.0,
         };
-        assert!((ex1.eval(5.0, 0.0, 8.0) - 51.75).abs() < 0.005, "{}", ex1.eval(5.0, 0.0, 8.0));
+        assert!(
+            (ex1.eval(5.0, 0.0, 8.0) - 51.75).abs() < 0.005,
+            "{}",
+            ex1.eval(5.0, 0.0, 8.0)
+        );
         let ex2 = Reference::BarInsulatedLeft {
             x0: 0.0,
             length: 10.0,
@@ -241,7 +249,11 @@ mod tests {
             initial_left: 60.0,
             initial_right: 0.0,
         };
-        assert!((ex2.eval(5.0, 0.0, 8.0) - 53.06).abs() < 0.005, "{}", ex2.eval(5.0, 0.0, 8.0));
+        assert!(
+            (ex2.eval(5.0, 0.0, 8.0) - 53.06).abs() < 0.005,
+            "{}",
+            ex2.eval(5.0, 0.0, 8.0)
+        );
     }
 
     /// Each series reproduces its initial and boundary data (tolerance from truncation).
@@ -312,7 +324,13 @@ mod tests {
         };
         for i in (0..=n).step_by(10) {
             let e = r.eval(i as f64 * h, 0.0, 3.0);
-            assert!((e - u[i]).abs() < 2e-3, "x = {}: {} vs {}", i as f64 * h, e, u[i]);
+            assert!(
+                (e - u[i]).abs() < 2e-3,
+                "x = {}: {} vs {}",
+                i as f64 * h,
+                e,
+                u[i]
+            );
         }
     }
 }

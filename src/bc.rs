@@ -63,7 +63,10 @@ pub enum FaceBc {
 impl FaceBc {
     /// True when the condition needs a fictitious layer.
     pub fn needs_layer(&self) -> bool {
-        matches!(self, FaceBc::LayerTemperature { .. } | FaceBc::LayerInsulated | FaceBc::LayerFlux { .. })
+        matches!(
+            self,
+            FaceBc::LayerTemperature { .. } | FaceBc::LayerInsulated | FaceBc::LayerFlux { .. }
+        )
     }
 }
 
@@ -146,14 +149,22 @@ pub struct BoundaryInput<'a> {
 fn project(cloud: &Cloud, p: &Point, face: Face) -> Point {
     let mut q = *p;
     let a = face / 2;
-    q[a] = if face % 2 == 0 { cloud.min[a] } else { cloud.max[a] };
+    q[a] = if face.is_multiple_of(2) {
+        cloud.min[a]
+    } else {
+        cloud.max[a]
+    };
     q
 }
 
 fn reflect(cloud: &Cloud, p: &Point, face: Face) -> Point {
     let mut q = *p;
     let a = face / 2;
-    let plane = if face % 2 == 0 { cloud.min[a] } else { cloud.max[a] };
+    let plane = if face.is_multiple_of(2) {
+        cloud.min[a]
+    } else {
+        cloud.max[a]
+    };
     q[a] = 2.0 * plane - p[a];
     q
 }
@@ -202,9 +213,11 @@ impl Boundary {
                     }
                 }
                 FaceBc::RelationFlux { value } => {
-                    let (h, micro) = input.micro.expect("micro-conductances are given for nodal flux relations");
+                    let (h, micro) = input
+                        .micro
+                        .expect("micro-conductances are given for nodal flux relations");
                     let a = face / 2;
-                    let inward = if face % 2 == 0 { 1.0 } else { -1.0 };
+                    let inward = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
                     for i in cloud.face_layer(face, 1.0) {
                         let mut stencil = Vec::new();
                         let mut wsum = 0.0;
@@ -231,7 +244,12 @@ impl Boundary {
                     let nodes = cloud
                         .face_layer(face, 1.0)
                         .into_iter()
-                        .map(|i| (i, *h * cloud.exposed_area(i) / (cloud.volume[i] * input.capacity[i])))
+                        .map(|i| {
+                            (
+                                i,
+                                *h * cloud.exposed_area(i) / (cloud.volume[i] * input.capacity[i]),
+                            )
+                        })
                         .collect();
                     b.convective.push(Convective {
                         nodes,
@@ -273,18 +291,30 @@ impl Boundary {
         if cloud.n_fictitious() == 0 {
             return;
         }
-        let body: Vec<[f64; 3]> = cloud.pos[..cloud.n_body].iter().map(|p| [p.x, p.y, p.z]).collect();
+        let body: Vec<[f64; 3]> = cloud.pos[..cloud.n_body]
+            .iter()
+            .map(|p| [p.x, p.y, p.z])
+            .collect();
         if body.is_empty() {
             return;
         }
-        let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&body).expect("non-empty body");
+        let tree: ImmutableKdTree<f64, 3> =
+            ImmutableKdTree::new_from_slice(&body).expect("non-empty body");
         let k_near = NonZero::new(1usize << cloud.dim).expect("non-zero");
         for f in 0..cloud.n_fictitious() {
             let node = cloud.n_body + f;
             let mask = cloud.outside[f];
             // naive faces first: they fix the value whatever follows
             let mut faces: Vec<Face> = (0..6).filter(|&fc| mask & (1 << fc) != 0).collect();
-            faces.sort_by_key(|&fc| !matches!(self.faces[fc], FaceBc::LayerTemperature { layer: Layer::Naive, .. }));
+            faces.sort_by_key(|&fc| {
+                !matches!(
+                    self.faces[fc],
+                    FaceBc::LayerTemperature {
+                        layer: Layer::Naive,
+                        ..
+                    }
+                )
+            });
             let mut p = cloud.pos[node];
             let mut s = 1.0;
             let mut terms = Vec::new();
@@ -292,8 +322,14 @@ impl Boundary {
                 let q = reflect(cloud, &p, fc);
                 let d = (q - p).norm();
                 let (sigma, coef) = match &self.faces[fc] {
-                    FaceBc::LayerTemperature { layer: Layer::Naive, .. } => (0.0, 1.0),
-                    FaceBc::LayerTemperature { layer: Layer::Mirror, .. } => (-1.0, 2.0),
+                    FaceBc::LayerTemperature {
+                        layer: Layer::Naive,
+                        ..
+                    } => (0.0, 1.0),
+                    FaceBc::LayerTemperature {
+                        layer: Layer::Mirror,
+                        ..
+                    } => (-1.0, 2.0),
                     FaceBc::LayerFlux { .. } => (1.0, 1.0 / conductivity[node]),
                     _ => (1.0, 0.0),
                 };
@@ -376,7 +412,14 @@ impl Boundary {
     }
 
     /// Adds the load rates (convection, volumetric source) of body nodes, K/s.
-    pub fn add_loads(&self, cloud: &Cloud, capacity: &[f64], theta: &[f64], t: f64, rate: &mut [f64]) {
+    pub fn add_loads(
+        &self,
+        cloud: &Cloud,
+        capacity: &[f64],
+        theta: &[f64],
+        t: f64,
+        rate: &mut [f64],
+    ) {
         for c in &self.convective {
             let amb = c.ambient.eval(0.0, 0.0, 0.0, t);
             for &(i, coef) in &c.nodes {

@@ -331,7 +331,11 @@ fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(case_err(path, key, format!("must be a positive number, got {v}")))
+        Err(case_err(
+            path,
+            key,
+            format!("must be a positive number, got {v}"),
+        ))
     }
 }
 
@@ -344,7 +348,10 @@ impl CaseFile {
         }
         let coords = |v: &[f64], key: &str| -> Result<[f64; 3]> {
             if v.len() != dim {
-                return Err(err(key, format!("needs {dim} coordinates, got {}", v.len())));
+                return Err(err(
+                    key,
+                    format!("needs {dim} coordinates, got {}", v.len()),
+                ));
             }
             let mut p = [0.0; 3];
             for (a, x) in v.iter().enumerate() {
@@ -359,38 +366,65 @@ impl CaseFile {
         let dmax = coords(&self.domain.max, "domain.max")?;
         for a in 0..dim {
             if dmax[a] <= dmin[a] {
-                return Err(err("domain.max", "must exceed domain.min on every axis".into()));
+                return Err(err(
+                    "domain.max",
+                    "must exceed domain.min on every axis".into(),
+                ));
             }
         }
         let tau = match dim {
             1 => {
                 if self.domain.thickness.is_some() {
-                    return Err(err("domain.thickness", "is for 2D; a 1D bar takes domain.area".into()));
+                    return Err(err(
+                        "domain.thickness",
+                        "is for 2D; a 1D bar takes domain.area".into(),
+                    ));
                 }
                 positive(path, "domain.area", self.domain.area.unwrap_or(1.0))?
             }
             2 => {
                 if self.domain.area.is_some() {
-                    return Err(err("domain.area", "is for 1D; a 2D body takes domain.thickness".into()));
+                    return Err(err(
+                        "domain.area",
+                        "is for 1D; a 2D body takes domain.thickness".into(),
+                    ));
                 }
-                positive(path, "domain.thickness", self.domain.thickness.unwrap_or(1.0))?
+                positive(
+                    path,
+                    "domain.thickness",
+                    self.domain.thickness.unwrap_or(1.0),
+                )?
             }
             _ => {
                 if self.domain.area.is_some() || self.domain.thickness.is_some() {
-                    return Err(err("domain", "a 3D body takes neither area nor thickness".into()));
+                    return Err(err(
+                        "domain",
+                        "a 3D body takes neither area nor thickness".into(),
+                    ));
                 }
                 1.0
             }
         };
         if self.material.is_empty() {
-            return Err(err("material", "define at least one [material.<name>]".into()));
+            return Err(err(
+                "material",
+                "define at least one [material.<name>]".into(),
+            ));
         }
         let names: Vec<&String> = self.material.keys().collect();
         let mut materials = Vec::new();
         for (name, m) in &self.material {
-            positive(path, &format!("material.{name}.conductivity"), m.conductivity)?;
+            positive(
+                path,
+                &format!("material.{name}.conductivity"),
+                m.conductivity,
+            )?;
             positive(path, &format!("material.{name}.density"), m.density)?;
-            positive(path, &format!("material.{name}.specific_heat"), m.specific_heat)?;
+            positive(
+                path,
+                &format!("material.{name}.specific_heat"),
+                m.specific_heat,
+            )?;
             materials.push(*m);
         }
         if self.region.is_empty() {
@@ -415,8 +449,18 @@ impl CaseFile {
             }
             let mut cells = [1usize; 3];
             match (&reg.spacing, &reg.cells) {
-                (Some(_), Some(_)) => return Err(err(&key("spacing"), "give spacing or cells, not both".into())),
-                (None, None) => return Err(err(&key("spacing"), "missing: give spacing or cells".into())),
+                (Some(_), Some(_)) => {
+                    return Err(err(
+                        &key("spacing"),
+                        "give spacing or cells, not both".into(),
+                    ))
+                }
+                (None, None) => {
+                    return Err(err(
+                        &key("spacing"),
+                        "missing: give spacing or cells".into(),
+                    ))
+                }
                 (Some(h), None) => {
                     let h = positive(path, &key("spacing"), *h)?;
                     for a in 0..dim {
@@ -425,7 +469,10 @@ impl CaseFile {
                         if nr < 1.0 || (n - nr).abs() > 1e-6 * n {
                             return Err(err(
                                 &key("spacing"),
-                                format!("{h} does not divide the region's side {} into whole cells", rmax[a] - rmin[a]),
+                                format!(
+                                    "{h} does not divide the region's side {} into whole cells",
+                                    rmax[a] - rmin[a]
+                                ),
                             ));
                         }
                         cells[a] = nr as usize;
@@ -439,16 +486,27 @@ impl CaseFile {
                 }
             }
             let horizon = match reg.horizon {
-                HorizonSpec::Factor(n) => HorizonRule::Factor(positive(path, &key("horizon.factor"), n)?),
-                HorizonSpec::Radius(d) => HorizonRule::Radius(positive(path, &key("horizon.radius"), d)?),
+                HorizonSpec::Factor(n) => {
+                    HorizonRule::Factor(positive(path, &key("horizon.factor"), n)?)
+                }
+                HorizonSpec::Radius(d) => {
+                    HorizonRule::Radius(positive(path, &key("horizon.radius"), d)?)
+                }
             };
             let material = match &reg.material {
-                Some(m) => names
-                    .iter()
-                    .position(|n| *n == m)
-                    .ok_or_else(|| err(&key("material"), format!("unknown material `{m}`; defined: {names:?}")))?,
+                Some(m) => names.iter().position(|n| *n == m).ok_or_else(|| {
+                    err(
+                        &key("material"),
+                        format!("unknown material `{m}`; defined: {names:?}"),
+                    )
+                })?,
                 None if names.len() == 1 => 0,
-                None => return Err(err(&key("material"), "several materials are defined: name one".into())),
+                None => {
+                    return Err(err(
+                        &key("material"),
+                        "several materials are defined: name one".into(),
+                    ))
+                }
             };
             per_region_initial.push(reg.initial);
             regions.push(BoxRegion {
@@ -461,7 +519,10 @@ impl CaseFile {
             });
         }
         if self.kernel.p != 1 && self.kernel.p != 2 {
-            return Err(err("kernel.p", format!("must be 1 or 2, got {}", self.kernel.p)));
+            return Err(err(
+                "kernel.p",
+                format!("must be 1 or 2, got {}", self.kernel.p),
+            ));
         }
         let kernel = Kernel {
             p: self.kernel.p,
@@ -472,12 +533,17 @@ impl CaseFile {
         let mut faces = vec![FaceBc::Free; 6];
         for (name, b) in &self.boundary {
             let key = |k: &str| format!("boundary.{name}.{k}");
-            let f = FACE_NAMES
-                .iter()
-                .position(|n| n == name)
-                .ok_or_else(|| err(&format!("boundary.{name}"), format!("unknown face; use one of {:?}", &FACE_NAMES[..2 * dim])))?;
+            let f = FACE_NAMES.iter().position(|n| n == name).ok_or_else(|| {
+                err(
+                    &format!("boundary.{name}"),
+                    format!("unknown face; use one of {:?}", &FACE_NAMES[..2 * dim]),
+                )
+            })?;
             if f >= 2 * dim {
-                return Err(err(&format!("boundary.{name}"), format!("a {dim}D case has faces {:?}", &FACE_NAMES[..2 * dim])));
+                return Err(err(
+                    &format!("boundary.{name}"),
+                    format!("a {dim}D case has faces {:?}", &FACE_NAMES[..2 * dim]),
+                ));
             }
             let value = |required: bool| -> Result<Option<Expr>> {
                 match &b.value {
@@ -487,17 +553,33 @@ impl CaseFile {
                 }
             };
             let method = b.method.as_deref();
-            let bad_method = |allowed: &str| err(&key("method"), format!("`{}` is not one of {allowed}", method.unwrap_or("")));
+            let bad_method = |allowed: &str| {
+                err(
+                    &key("method"),
+                    format!("`{}` is not one of {allowed}", method.unwrap_or("")),
+                )
+            };
             let unused = |k: &str, present: bool| -> Result<()> {
                 if present {
-                    Err(err(&key(k), format!("does not apply to type = \"{:?}\"", b.kind).to_lowercase()))
+                    Err(err(
+                        &key(k),
+                        format!("does not apply to type = \"{:?}\"", b.kind).to_lowercase(),
+                    ))
                 } else {
                     Ok(())
                 }
             };
-            unused("layers", b.layers.is_some() && !(b.kind == BoundaryKind::Temperature && matches!(method, None | Some("nodal"))))?;
+            unused(
+                "layers",
+                b.layers.is_some()
+                    && !(b.kind == BoundaryKind::Temperature
+                        && matches!(method, None | Some("nodal"))),
+            )?;
             unused("h", b.h.is_some() && b.kind != BoundaryKind::Convection)?;
-            unused("ambient", b.ambient.is_some() && b.kind != BoundaryKind::Convection)?;
+            unused(
+                "ambient",
+                b.ambient.is_some() && b.kind != BoundaryKind::Convection,
+            )?;
             faces[f] = match b.kind {
                 BoundaryKind::Free => {
                     unused("value", b.value.is_some())?;
@@ -509,12 +591,21 @@ impl CaseFile {
                         None | Some("nodal") => {
                             let layers = b.layers.unwrap_or(1.0);
                             if !(layers >= 1.0 && layers.fract() == 0.0) {
-                                return Err(err(&key("layers"), format!("must be a whole number >= 1, got {layers}")));
+                                return Err(err(
+                                    &key("layers"),
+                                    format!("must be a whole number >= 1, got {layers}"),
+                                ));
                             }
                             FaceBc::NodalTemperature { value: v, layers }
                         }
-                        Some("mirror") => FaceBc::LayerTemperature { value: v, layer: Layer::Mirror },
-                        Some("naive") => FaceBc::LayerTemperature { value: v, layer: Layer::Naive },
+                        Some("mirror") => FaceBc::LayerTemperature {
+                            value: v,
+                            layer: Layer::Mirror,
+                        },
+                        Some("naive") => FaceBc::LayerTemperature {
+                            value: v,
+                            layer: Layer::Naive,
+                        },
                         _ => return Err(bad_method("nodal, mirror, naive")),
                     }
                 }
@@ -536,8 +627,15 @@ impl CaseFile {
                 }
                 BoundaryKind::Convection => {
                     unused("value", b.value.is_some())?;
-                    let h = positive(path, &key("h"), b.h.ok_or_else(|| err(&key("h"), "missing".into()))?)?;
-                    let amb = b.ambient.as_ref().ok_or_else(|| err(&key("ambient"), "missing".into()))?;
+                    let h = positive(
+                        path,
+                        &key("h"),
+                        b.h.ok_or_else(|| err(&key("h"), "missing".into()))?,
+                    )?;
+                    let amb = b
+                        .ambient
+                        .as_ref()
+                        .ok_or_else(|| err(&key("ambient"), "missing".into()))?;
                     FaceBc::Convection {
                         h,
                         ambient: expr(amb, path, &key("ambient"))?,
@@ -554,7 +652,10 @@ impl CaseFile {
         }
         let initial = if per_region_initial.iter().any(Option::is_some) {
             if !base.is_uniform() {
-                return Err(err("region.initial", "cannot be combined with an [initial] expression of x, y, z".into()));
+                return Err(err(
+                    "region.initial",
+                    "cannot be combined with an [initial] expression of x, y, z".into(),
+                ));
             }
             let b0 = base.eval(0.0, 0.0, 0.0, 0.0);
             Initial::PerRegion(per_region_initial.iter().map(|v| v.unwrap_or(b0)).collect())
@@ -575,10 +676,16 @@ impl CaseFile {
         }
         for (k, &t) in outputs.iter().enumerate() {
             if !(t > 0.0 && t <= end * (1.0 + 1e-12)) {
-                return Err(err(&format!("time.outputs[{k}]"), format!("{t} is not in (0, time.end = {end}]")));
+                return Err(err(
+                    &format!("time.outputs[{k}]"),
+                    format!("{t} is not in (0, time.end = {end}]"),
+                ));
             }
             if k > 0 && t <= outputs[k - 1] {
-                return Err(err(&format!("time.outputs[{k}]"), "output times must increase".into()));
+                return Err(err(
+                    &format!("time.outputs[{k}]"),
+                    "output times must increase".into(),
+                ));
             }
         }
         let geometry = BoxGeometry {

@@ -63,7 +63,7 @@ impl Cloud {
     /// Signed distance of a point inside the body to a face of the bounding box, m.
     pub fn distance_to_face(&self, p: &Point, face: Face) -> f64 {
         let a = face / 2;
-        if face % 2 == 0 {
+        if face.is_multiple_of(2) {
             p[a] - self.min[a]
         } else {
             self.max[a] - p[a]
@@ -165,12 +165,16 @@ const REL: f64 = 1e-9;
 impl BoxGeometry {
     /// Checks the tiling and the lattices; errors name the region.
     pub fn validate(&self) -> Result<()> {
-        let measure = |min: &[f64; 3], max: &[f64; 3]| -> f64 { (0..self.dim).map(|a| max[a] - min[a]).product() };
+        let measure = |min: &[f64; 3], max: &[f64; 3]| -> f64 {
+            (0..self.dim).map(|a| max[a] - min[a]).product()
+        };
         let total = measure(&self.min, &self.max);
         if total <= 0.0 {
             return Err(Error::model("domain", "max must exceed min on every axis"));
         }
-        let scale = (0..self.dim).map(|a| self.max[a] - self.min[a]).fold(0.0, f64::max);
+        let scale = (0..self.dim)
+            .map(|a| self.max[a] - self.min[a])
+            .fold(0.0, f64::max);
         let mut sum = 0.0;
         for (r, reg) in self.regions.iter().enumerate() {
             let key = format!("region.{}", reg.name);
@@ -178,7 +182,8 @@ impl BoxGeometry {
                 if reg.max[a] <= reg.min[a] {
                     return Err(Error::model(&key, "max must exceed min on every axis"));
                 }
-                if reg.min[a] < self.min[a] - REL * scale || reg.max[a] > self.max[a] + REL * scale {
+                if reg.min[a] < self.min[a] - REL * scale || reg.max[a] > self.max[a] + REL * scale
+                {
                     return Err(Error::model(&key, "region extends outside the domain"));
                 }
                 if reg.cells[a] == 0 {
@@ -190,7 +195,11 @@ impl BoxGeometry {
                 if (reg.h(a) - h0).abs() > 1e-6 * h0 {
                     return Err(Error::model(
                         &key,
-                        format!("cells must be square: spacing {} on x but {} on axis {a}", h0, reg.h(a)),
+                        format!(
+                            "cells must be square: spacing {} on x but {} on axis {a}",
+                            h0,
+                            reg.h(a)
+                        ),
                     ));
                 }
             }
@@ -200,7 +209,10 @@ impl BoxGeometry {
                     .map(|a| (reg.max[a].min(other.max[a]) - reg.min[a].max(other.min[a])).max(0.0))
                     .product();
                 if overlap > REL * total {
-                    return Err(Error::model(&key, format!("overlaps region {}", other.name)));
+                    return Err(Error::model(
+                        &key,
+                        format!("overlaps region {}", other.name),
+                    ));
                 }
             }
         }
@@ -231,11 +243,13 @@ impl BoxGeometry {
             boundary_placement: self.boundary_placement,
             ..Default::default()
         };
-        let scale = (0..self.dim).map(|a| self.max[a] - self.min[a]).fold(0.0, f64::max);
+        let scale = (0..self.dim)
+            .map(|a| self.max[a] - self.min[a])
+            .fold(0.0, f64::max);
         let eps = REL * scale;
         let on_face = |reg: &BoxRegion, face: Face| {
             let a = face / 2;
-            if face % 2 == 0 {
+            if face.is_multiple_of(2) {
                 (reg.min[a] - self.min[a]).abs() < eps
             } else {
                 (reg.max[a] - self.max[a]).abs() < eps
@@ -337,7 +351,16 @@ mod tests {
             min: [-0.5, -0.5, 0.0],
             max: [0.5, 0.5, 0.0],
             boundary_placement: bp,
-            regions: if bp { vec![BoxRegion { min: [-0.5, -0.5, 0.0], max: [0.5, 0.5, 0.0], cells: [20, 20, 1], ..left }] } else { vec![left, right] },
+            regions: if bp {
+                vec![BoxRegion {
+                    min: [-0.5, -0.5, 0.0],
+                    max: [0.5, 0.5, 0.0],
+                    cells: [20, 20, 1],
+                    ..left
+                }]
+            } else {
+                vec![left, right]
+            },
         }
     }
 
@@ -356,9 +379,17 @@ mod tests {
         let c = plate(true, 1.0).generate(0, 0.0).unwrap();
         assert_eq!(c.n_body, 21 * 21);
         let h2 = 0.05 * 0.05 * 0.1;
-        let corner = c.pos.iter().position(|p| p.x == -0.5 && p.y == -0.5).unwrap();
+        let corner = c
+            .pos
+            .iter()
+            .position(|p| p.x == -0.5 && p.y == -0.5)
+            .unwrap();
         assert!((c.volume[corner] - h2 / 4.0).abs() < 1e-18);
-        let edge = c.pos.iter().position(|p| p.x == -0.5 && (p.y - 0.0).abs() < 1e-12).unwrap();
+        let edge = c
+            .pos
+            .iter()
+            .position(|p| p.x == -0.5 && (p.y - 0.0).abs() < 1e-12)
+            .unwrap();
         assert!((c.volume[edge] - h2 / 2.0).abs() < 1e-18);
     }
 

@@ -266,7 +266,9 @@ impl Parser<'_> {
     }
     fn name(&mut self) -> Result<Node> {
         let start = self.i;
-        while self.i < self.s.len() && (self.s[self.i].is_ascii_alphanumeric() || self.s[self.i] == b'_') {
+        while self.i < self.s.len()
+            && (self.s[self.i].is_ascii_alphanumeric() || self.s[self.i] == b'_')
+        {
             self.i += 1;
         }
         let name = &self.text[start..self.i];
@@ -347,7 +349,12 @@ mod tests {
         let e = Expr::parse("-2^2 + 3*(x<5) + 1e-1*y - z/2").unwrap();
         assert!((e.eval(1.0, 10.0, 4.0, 0.0) - (-4.0 + 3.0 + 1.0 - 2.0)).abs() < 1e-15);
         assert_eq!(e.eval(6.0, 0.0, 0.0, 0.0), -4.0);
-        assert_eq!(Expr::parse("max(x, 2) + pow(2, 3)").unwrap().eval(1.0, 0.0, 0.0, 0.0), 10.0);
+        assert_eq!(
+            Expr::parse("max(x, 2) + pow(2, 3)")
+                .unwrap()
+                .eval(1.0, 0.0, 0.0, 0.0),
+            10.0
+        );
     }
 
     #[test]

@@ -113,7 +113,9 @@ impl Kernel {
     pub fn calibrated(&self, dim: usize, k: f64, delta: f64, tau: f64, h: f64) -> f64 {
         match self.calibration {
             Calibration::Continuum => self.normalisation(dim, k, delta, tau),
-            Calibration::Lattice => 2.0 * dim as f64 * k / (tau * self.lattice_moment(dim, delta, h)),
+            Calibration::Lattice => {
+                2.0 * dim as f64 * k / (tau * self.lattice_moment(dim, delta, h))
+            }
         }
     }
 
@@ -179,18 +181,39 @@ mod tests {
         let (k, d, a) = (1.7, 0.3, 0.2);
         let close = |x: f64, y: f64| assert!((x - y).abs() <= 1e-13 * y.abs(), "{x} vs {y}");
         // seed 000 eq 16: k0 = κ/δ (per cross-section A)
-        close(kern(2, Profile::Constant).normalisation(1, k, d, a), k / d / a);
+        close(
+            kern(2, Profile::Constant).normalisation(1, k, d, a),
+            k / d / a,
+        );
         // seed 000 eq 17: k1 = 2κ/δ
-        close(kern(2, Profile::Conical).normalisation(1, k, d, a), 2.0 * k / d / a);
+        close(
+            kern(2, Profile::Conical).normalisation(1, k, d, a),
+            2.0 * k / d / a,
+        );
         // seed 003 §2.3.1: 4κ/(πδ²) per thickness h
-        close(kern(2, Profile::Constant).normalisation(2, k, d, a), 4.0 * k / (PI * d * d * a));
+        close(
+            kern(2, Profile::Constant).normalisation(2, k, d, a),
+            4.0 * k / (PI * d * d * a),
+        );
         // seed 003 §2.3.2: 12κ/(πδ²)
-        close(kern(2, Profile::Conical).normalisation(2, k, d, a), 12.0 * k / (PI * d * d * a));
+        close(
+            kern(2, Profile::Conical).normalisation(2, k, d, a),
+            12.0 * k / (PI * d * d * a),
+        );
         // seed 004 eq 18: 6k/(πhδ³)
-        close(kern(1, Profile::Constant).normalisation(2, k, d, a), 6.0 * k / (PI * a * d.powi(3)));
+        close(
+            kern(1, Profile::Constant).normalisation(2, k, d, a),
+            6.0 * k / (PI * a * d.powi(3)),
+        );
         // 3D p = 1: 6k/(πδ⁴); 3D constant p = 2: 9k/(2πδ³)
-        close(kern(1, Profile::Constant).normalisation(3, k, d, 1.0), 6.0 * k / (PI * d.powi(4)));
-        close(kern(2, Profile::Constant).normalisation(3, k, d, 1.0), 9.0 * k / (2.0 * PI * d.powi(3)));
+        close(
+            kern(1, Profile::Constant).normalisation(3, k, d, 1.0),
+            6.0 * k / (PI * d.powi(4)),
+        );
+        close(
+            kern(2, Profile::Constant).normalisation(3, k, d, 1.0),
+            9.0 * k / (2.0 * PI * d.powi(3)),
+        );
     }
 
     /// The normalisation makes ∫ c(r) ξ_x² dV / 2 = k for a quadratic field, checked by
@@ -199,7 +222,11 @@ mod tests {
     fn normalisation_reproduces_conductivity_by_quadrature() {
         let (k, d) = (2.5, 1.0);
         for dim in 1..=3 {
-            for (p, prof) in [(2, Profile::Constant), (2, Profile::Conical), (1, Profile::Constant)] {
+            for (p, prof) in [
+                (2, Profile::Constant),
+                (2, Profile::Conical),
+                (1, Profile::Constant),
+            ] {
                 let ker = kern(p, prof);
                 let c = ker.normalisation(dim, k, d, 1.0);
                 let n = if dim == 3 { 120 } else { 600 };
@@ -222,7 +249,10 @@ mod tests {
                     }
                 }
                 let got = 0.5 * sum;
-                assert!((got - k).abs() < 1e-2 * k, "dim {dim} p {p} {prof:?}: {got}");
+                assert!(
+                    (got - k).abs() < 1e-2 * k,
+                    "dim {dim} p {p} {prof:?}: {got}"
+                );
             }
         }
     }
@@ -235,11 +265,20 @@ mod tests {
         let ratio = k.lattice_moment(1, 1.0, 0.25) / k.moment(1, 1.0);
         assert!((ratio - 7.0 / 8.0).abs() < 1e-12, "{ratio}");
         for dim in 2..=3 {
-            for (p, prof) in [(2, Profile::Constant), (2, Profile::Conical), (1, Profile::Constant)] {
+            for (p, prof) in [
+                (2, Profile::Constant),
+                (2, Profile::Conical),
+                (1, Profile::Constant),
+            ] {
                 let k = kern(p, prof);
-                let coarse = (k.lattice_moment(dim, 1.0, 1.0 / 3.0) / k.moment(dim, 1.0) - 1.0).abs();
-                let fine = (k.lattice_moment(dim, 1.0, 1.0 / 12.0) / k.moment(dim, 1.0) - 1.0).abs();
-                assert!(fine < 0.02 && fine < coarse, "dim {dim} p {p} {prof:?}: {coarse} -> {fine}");
+                let coarse =
+                    (k.lattice_moment(dim, 1.0, 1.0 / 3.0) / k.moment(dim, 1.0) - 1.0).abs();
+                let fine =
+                    (k.lattice_moment(dim, 1.0, 1.0 / 12.0) / k.moment(dim, 1.0) - 1.0).abs();
+                assert!(
+                    fine < 0.02 && fine < coarse,
+                    "dim {dim} p {p} {prof:?}: {coarse} -> {fine}"
+                );
             }
         }
     }

@@ -11,7 +11,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "peritherm", version, about = "Transient heat conduction with dual-horizon peridynamics")]
+#[command(
+    name = "peritherm",
+    version,
+    about = "Transient heat conduction with dual-horizon peridynamics"
+)]
 struct Cli {
     /// Worker threads (default: all cores).
     #[arg(long, global = true)]
@@ -67,8 +71,10 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 bar.set_draw_target(ProgressDrawTarget::hidden());
             }
             bar.set_style(
-                ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}")
-                    .expect("valid template"),
+                ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}",
+                )
+                .expect("valid template"),
             );
             let summary = run_case(&case, &out, |done, total| {
                 bar.set_length(total);
@@ -95,7 +101,8 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Check { case } => {
             let case = Case::load(&case)?;
-            let model = Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
+            let model =
+                Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
             let bound = case.integrator.stable_dt(&model);
             println!(
                 "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
@@ -108,7 +115,10 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             );
             if let Some(dt) = case.dt {
                 if dt > bound {
-                    anyhow::bail!("{}: time.dt: {dt:e} s exceeds the stable bound {bound:e} s", case.path.display());
+                    anyhow::bail!(
+                        "{}: time.dt: {dt:e} s exceeds the stable bound {bound:e} s",
+                        case.path.display()
+                    );
                 }
             }
             Ok(())

@@ -68,7 +68,10 @@ impl Model {
                 ("specific_heat", mat.specific_heat),
             ] {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(Error::model(format!("material[{m}].{name}"), format!("must be a positive number, got {v}")));
+                    return Err(Error::model(
+                        format!("material[{m}].{name}"),
+                        format!("must be a positive number, got {v}"),
+                    ));
                 }
             }
         }
@@ -101,9 +104,19 @@ impl Model {
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
         let horizons = Horizons::build(&cloud, &spec.kernel);
-        let weights = directed_weights(&cloud, &horizons, &spec.kernel, &conductivity, spec.bond_rule);
+        let weights = directed_weights(
+            &cloud,
+            &horizons,
+            &spec.kernel,
+            &conductivity,
+            spec.bond_rule,
+        );
         let conductance = Conductance::assemble(&cloud, &horizons, &weights);
-        let needs_micro = spec.faces.iter().any(|f| matches!(f, FaceBc::RelationFlux { .. })) && cloud.dim > 1;
+        let needs_micro = spec
+            .faces
+            .iter()
+            .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
+            && cloud.dim > 1;
         let micro: Vec<f64> = if needs_micro {
             (0..horizons.len())
                 .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
@@ -117,16 +130,29 @@ impl Model {
             faces: spec.faces.clone(),
             conductivity: &conductivity,
             capacity: &capacity,
-            micro: if needs_micro { Some((&horizons, &micro)) } else { None },
+            micro: if needs_micro {
+                Some((&horizons, &micro))
+            } else {
+                None
+            },
             source: spec.source.clone(),
         });
-        let inv_heat_capacity = (0..cloud.n_body).map(|i| 1.0 / (cloud.volume[i] * capacity[i])).collect();
+        let inv_heat_capacity = (0..cloud.n_body)
+            .map(|i| 1.0 / (cloud.volume[i] * capacity[i]))
+            .collect();
         let mut theta0: Vec<f64> = match &spec.initial {
-            Initial::Field(e) => cloud.pos.iter().map(|p| e.eval(p.x, p.y, p.z, 0.0)).collect(),
+            Initial::Field(e) => cloud
+                .pos
+                .iter()
+                .map(|p| e.eval(p.x, p.y, p.z, 0.0))
+                .collect(),
             Initial::PerRegion(v) => cloud.region.iter().map(|&r| v[r as usize]).collect(),
         };
         if let Some(i) = theta0.iter().position(|v| !v.is_finite()) {
-            return Err(Error::model("initial", format!("initial temperature is not finite at node {i}")));
+            return Err(Error::model(
+                "initial",
+                format!("initial temperature is not finite at node {i}"),
+            ));
         }
         boundary.apply(&cloud, &mut theta0, 0.0);
         Ok(Model {

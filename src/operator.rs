@@ -44,17 +44,20 @@ pub fn directed_weights(
         }
         out
     };
-    chunks.into_par_iter().with_min_len(256).for_each(|(i, slot)| {
-        let delta = cloud.horizon[i];
-        let unit = units[i];
-        for (s, b) in slot.iter_mut().zip(horizons.row(i)) {
-            let j = horizons.targets[b] as usize;
-            let r = (cloud.pos[j] - cloud.pos[i]).norm();
-            let k = rule.combine(conductivity[i], conductivity[j]);
-            let c = kernel.micro(unit * k, r, horizons.eval_at[b], delta);
-            *s = 0.5 * cloud.volume[i] * cloud.volume[j] * c * horizons.beta[b];
-        }
-    });
+    chunks
+        .into_par_iter()
+        .with_min_len(256)
+        .for_each(|(i, slot)| {
+            let delta = cloud.horizon[i];
+            let unit = units[i];
+            for (s, b) in slot.iter_mut().zip(horizons.row(i)) {
+                let j = horizons.targets[b] as usize;
+                let r = (cloud.pos[j] - cloud.pos[i]).norm();
+                let k = rule.combine(conductivity[i], conductivity[j]);
+                let c = kernel.micro(unit * k, r, horizons.eval_at[b], delta);
+                *s = 0.5 * cloud.volume[i] * cloud.volume[j] * c * horizons.beta[b];
+            }
+        });
     w
 }
 
@@ -102,7 +105,10 @@ impl Conductance {
             .map(|i| {
                 let out = horizons.row(i);
                 let (ot, ow) = (&horizons.targets[out.clone()], &weights[out]);
-                let (it, iw) = (&in_src[in_off[i]..in_off[i + 1]], &in_w[in_off[i]..in_off[i + 1]]);
+                let (it, iw) = (
+                    &in_src[in_off[i]..in_off[i + 1]],
+                    &in_w[in_off[i]..in_off[i + 1]],
+                );
                 let mut cols = Vec::with_capacity(ot.len().max(it.len()));
                 let mut vals = Vec::with_capacity(cols.capacity());
                 let (mut a, mut b) = (0, 0);

@@ -11,7 +11,10 @@ use std::path::{Path, PathBuf};
 
 /// Writes `bytes` to a temporary file beside `path`, then renames it into place.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.partial"));
     let io = |source| Error::Io {
         path: path.to_path_buf(),
@@ -30,12 +33,11 @@ pub fn field_path(dir: &Path, k: usize) -> PathBuf {
 pub fn field_csv(cloud: &Cloud, theta: &[f64]) -> String {
     let mut s = String::with_capacity(cloud.n_body * 80);
     s.push_str("x,y,z,temperature,region,spacing,horizon,volume\n");
-    for i in 0..cloud.n_body {
-        let p = cloud.pos[i];
+    for (i, (p, t)) in cloud.pos.iter().zip(theta).take(cloud.n_body).enumerate() {
         let _ = writeln!(
             s,
             "{},{},{},{},{},{},{},{}",
-            p.x, p.y, p.z, theta[i], cloud.region[i], cloud.spacing[i], cloud.horizon[i], cloud.volume[i]
+            p.x, p.y, p.z, t, cloud.region[i], cloud.spacing[i], cloud.horizon[i], cloud.volume[i]
         );
     }
     s

@@ -6,9 +6,17 @@ use crate::output::Comparison;
 
 /// Compares the body temperatures with `reference` at time `t`; `line_y` selects the
 /// probe line of seed 003 eq 13 (nodes within half a spacing of y = line_y).
-pub fn compare(cloud: &Cloud, theta: &[f64], reference: &Reference, line_y: Option<f64>, t: f64) -> Comparison {
+pub fn compare(
+    cloud: &Cloud,
+    theta: &[f64],
+    reference: &Reference,
+    line_y: Option<f64>,
+    t: f64,
+) -> Comparison {
     let n = cloud.n_body;
-    let classical: Vec<f64> = (0..n).map(|i| reference.eval(cloud.pos[i].x, cloud.pos[i].y, t)).collect();
+    let classical: Vec<f64> = (0..n)
+        .map(|i| reference.eval(cloud.pos[i].x, cloud.pos[i].y, t))
+        .collect();
     let mut max_abs: f64 = 0.0;
     let (mut sq_rel, mut n_rel) = (0.0, 0usize);
     let (mut sq, mut cmax) = (0.0, 0.0f64);
@@ -36,9 +44,17 @@ pub fn compare(cloud: &Cloud, theta: &[f64], reference: &Reference, line_y: Opti
     Comparison {
         time: t,
         max_abs_diff: max_abs,
-        mean_sq_rel_diff: if n_rel > 0 { sq_rel / n_rel as f64 } else { 0.0 },
+        mean_sq_rel_diff: if n_rel > 0 {
+            sq_rel / n_rel as f64
+        } else {
+            0.0
+        },
         l2_rel_line: if den > 0.0 { (num / den).sqrt() } else { 0.0 },
-        epsilon: if cmax > 0.0 { (sq / n as f64).sqrt() / cmax } else { 0.0 },
+        epsilon: if cmax > 0.0 {
+            (sq / n as f64).sqrt() / cmax
+        } else {
+            0.0
+        },
         line_nodes: n_line,
     }
 }

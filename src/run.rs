@@ -50,7 +50,12 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
             energy.push(model.energy(th));
             let path = field_path(out, k + 1);
             write_atomic(&path, field_csv(&model.cloud, th).as_bytes())?;
-            fields.push(path.file_name().expect("file").to_string_lossy().into_owned());
+            fields.push(
+                path.file_name()
+                    .expect("file")
+                    .to_string_lossy()
+                    .into_owned(),
+            );
             if let Some(r) = &case.reference {
                 comparisons.push(compare(&model.cloud, th, &r.solution, r.line_y, t));
             }

@@ -1,5 +1,6 @@
 //! Exact invariants: energy conservation, symmetry of K, linear fields, serial == parallel,
 //! and the explicit stability bound.
+#![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
 use peritherm::case::Case;
 use peritherm::model::Model;
@@ -61,9 +62,17 @@ fn energy_is_conserved_with_dual_horizon() {
             st.step(&mut theta, s as f64 * dt, dt);
         }
         let e1 = model.energy(&theta);
-        let spread = theta.iter().cloned().fold(f64::MIN, f64::max) - theta.iter().cloned().fold(f64::MAX, f64::min);
-        assert!(spread > 0.1, "the field must still vary for the test to mean anything");
-        assert!(((e1 - e0) / e0).abs() <= 1e-12, "{integ:?}: drift {}", (e1 - e0) / e0);
+        let spread = theta.iter().cloned().fold(f64::MIN, f64::max)
+            - theta.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(
+            spread > 0.1,
+            "the field must still vary for the test to mean anything"
+        );
+        assert!(
+            ((e1 - e0) / e0).abs() <= 1e-12,
+            "{integ:?}: drift {}",
+            (e1 - e0) / e0
+        );
     }
 }
 
@@ -140,7 +149,8 @@ type = "insulated"
     spec.geometry.regions.truncate(1);
     spec.geometry.regions[0].max[0] = 2.0;
     spec.geometry.regions[0].cells[0] = 80;
-    spec.initial = peritherm::model::Initial::Field(peritherm::expr::Expr::parse("1 + 3*x").unwrap());
+    spec.initial =
+        peritherm::model::Initial::Field(peritherm::expr::Expr::parse("1 + 3*x").unwrap());
     let model = Model::build(&spec).unwrap();
     let mut theta = model.theta0.clone();
     model.boundary.apply(&model.cloud, &mut theta, 0.0);
@@ -148,7 +158,11 @@ type = "insulated"
     model.conductance.apply(&theta, &mut flow);
     let scale = model.conductance.diag.iter().cloned().fold(0.0, f64::max) * 0.1;
     for (i, f) in flow.iter().enumerate() {
-        assert!(f.abs() < 1e-9 * scale, "node {i} at {}: {f}", model.cloud.pos[i]);
+        assert!(
+            f.abs() < 1e-9 * scale,
+            "node {i} at {}: {f}",
+            model.cloud.pos[i]
+        );
     }
 }
 
@@ -158,7 +172,10 @@ fn serial_and_parallel_products_agree_exactly() {
     let model = Model::build(&dual_horizon_case("", "lattice").spec).unwrap();
     let mut a = vec![0.0; model.cloud.n_body];
     let mut b = a.clone();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     pool.install(|| model.conductance.apply(&model.theta0, &mut a));
     model.conductance.apply_serial(&model.theta0, &mut b);
     assert_eq!(a, b);
@@ -172,7 +189,9 @@ fn time_step_bound() {
     let model = Model::build(&dual_horizon_case("", "continuum").spec).unwrap();
     let n = model.cloud.n_body;
     // power iteration on A = M⁻¹ L (free nodes), shifted to its largest magnitude
-    let mut v: Vec<f64> = (0..n).map(|i| if i % 2 == 0 { 1.0 } else { -0.7 }).collect();
+    let mut v: Vec<f64> = (0..n)
+        .map(|i| if i % 2 == 0 { 1.0 } else { -0.7 })
+        .collect();
     let mut lambda = 0.0;
     let mut w = vec![0.0; n];
     for _ in 0..3000 {
@@ -191,8 +210,14 @@ fn time_step_bound() {
     }
     let bound = Integrator::Euler.stable_dt(&model);
     let exact = 2.0 / lambda;
-    assert!(bound <= exact * (1.0 + 1e-6), "bound {bound} vs exact {exact}");
-    assert!(bound > 0.25 * exact, "bound {bound} is too pessimistic vs {exact}");
+    assert!(
+        bound <= exact * (1.0 + 1e-6),
+        "bound {bound} vs exact {exact}"
+    );
+    assert!(
+        bound > 0.25 * exact,
+        "bound {bound} is too pessimistic vs {exact}"
+    );
     let amplitude = |dt: f64| {
         let mut theta = model.theta0.clone();
         let mut st = Explicit::new(&model, Integrator::Euler);
@@ -204,6 +229,8 @@ fn time_step_bound() {
     let a0 = model.theta0[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(amplitude(bound) <= a0 * (1.0 + 1e-9));
     assert!(amplitude(1.2 * exact) > 1e3 * a0);
-    let err = choose_dt(&model, Integrator::Euler, Some(2.0 * bound)).unwrap_err().to_string();
+    let err = choose_dt(&model, Integrator::Euler, Some(2.0 * bound))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("exceeds the stable bound"), "{err}");
 }

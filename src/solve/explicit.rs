@@ -63,7 +63,10 @@ pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Re
         }),
         Some(dt) => Ok(dt),
         None if bound.is_finite() => Ok(0.95 * bound),
-        None => Err(Error::model("time.dt", "every node is driven; give time.dt explicitly")),
+        None => Err(Error::model(
+            "time.dt",
+            "every node is driven; give time.dt explicitly",
+        )),
     }
 }
 
@@ -82,9 +85,16 @@ fn rates(model: &Model, theta: &[f64], t: f64, out: &mut [f64]) {
     let k = &model.conductance;
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
-    out.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, o)| {
-        *o = if driven[i] { 0.0 } else { k.row_flow(i, theta) * inv[i] };
-    });
+    out.par_iter_mut()
+        .with_min_len(1024)
+        .enumerate()
+        .for_each(|(i, o)| {
+            *o = if driven[i] {
+                0.0
+            } else {
+                k.row_flow(i, theta) * inv[i]
+            };
+        });
     if model.boundary.has_loads() {
         model
             .boundary
@@ -113,7 +123,13 @@ impl<'a> Explicit<'a> {
             Integrator::Euler => 1,
             Integrator::Rk4 => 4,
         };
-        let k = std::array::from_fn(|s| if s < stages { vec![0.0; nb] } else { Vec::new() });
+        let k = std::array::from_fn(|s| {
+            if s < stages {
+                vec![0.0; nb]
+            } else {
+                Vec::new()
+            }
+        });
         Explicit {
             model,
             integrator,

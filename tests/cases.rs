@@ -1,0 +1,37 @@
+//! Every bundled case parses, builds, honours its own stability bound and runs a few steps.
+
+use peritherm::case::Case;
+use peritherm::model::Model;
+use peritherm::run::run_case;
+use std::path::Path;
+
+#[test]
+fn every_case_builds_and_starts() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 13, "{names:?}");
+    for path in names {
+        let mut case = Case::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let model = Model::build(&case.spec).unwrap();
+        let bound = case.integrator.stable_dt(&model);
+        if let Some(dt) = case.dt {
+            assert!(
+                dt <= bound,
+                "{}: dt {dt} above the bound {bound}",
+                path.display()
+            );
+        }
+        // a few steps only: the full runs are the README's benchmark table
+        let dt = case.dt.unwrap_or(0.9 * bound);
+        case.outputs = vec![3.0 * dt];
+        let out = tempfile::tempdir().unwrap();
+        let s = run_case(&case, out.path(), |_, _| {}).unwrap();
+        assert_eq!(s.steps, 3, "{}", path.display());
+        assert!(out.path().join("field_1.csv").exists());
+    }
+}

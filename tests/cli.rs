@@ -1,0 +1,158 @@
+//! The command line as a user meets it: the output contract and bad input.
+
+use std::path::Path;
+use std::process::Command;
+
+const SMALL: &str = r#"
+dimension = 2
+[domain]
+min = [0.0, 0.0]
+max = [1.0, 0.5]
+thickness = 0.1
+[[region]]
+name = "plate"
+spacing = 0.05
+horizon = { factor = 3.0 }
+[material.steel]
+conductivity = 50.0
+density = 7850.0
+specific_heat = 420.0
+[boundary.x_min]
+type = "temperature"
+method = "mirror"
+value = "100*(1 - exp(-t))"
+[boundary.x_max]
+type = "convection"
+h = 20.0
+ambient = 20.0
+[time]
+end = 2.0
+outputs = [1.0, 2.0]
+"#;
+
+fn peritherm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_peritherm"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn write_case(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+/// field_<k>.csv has x,y,z,temperature and one row per body node; run.json has the keys.
+#[test]
+fn run_honours_the_output_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path(), "small.toml", SMALL);
+    let out = dir.path().join("out");
+    let o = peritherm(&["run", &case, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    for key in [
+        "nodes",
+        "bonds",
+        "steps",
+        "dt",
+        "output_times",
+        "wall_seconds",
+        "energy",
+    ] {
+        assert!(json.get(key).is_some(), "run.json lacks {key}");
+    }
+    let nodes = json["nodes"].as_u64().unwrap() as usize;
+    assert_eq!(nodes, 20 * 10);
+    assert_eq!(json["energy"].as_array().unwrap().len(), 2);
+    for k in 1..=2 {
+        let text = std::fs::read_to_string(out.join(format!("field_{k}.csv"))).unwrap();
+        let mut lines = text.lines();
+        assert!(lines.next().unwrap().starts_with("x,y,z,temperature"));
+        assert_eq!(lines.count(), nodes);
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".partial")
+        })
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+/// Each class of bad input: non-zero exit, one line naming the file and the key, no panic,
+/// and no output directory.
+#[test]
+fn bad_input_fails_with_one_clear_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&str, String, &str)] = &[
+        (
+            "unknown key",
+            SMALL.replace("[time]", "[time]\nstep = 1"),
+            "step",
+        ),
+        ("missing field", SMALL.replace("end = 2.0\n", ""), "end"),
+        (
+            "negative conductivity",
+            SMALL.replace("conductivity = 50.0", "conductivity = -50.0"),
+            "material.steel.conductivity",
+        ),
+        (
+            "unstable dt",
+            SMALL.replace("[time]", "[time]\ndt = 1e6"),
+            "time.dt",
+        ),
+        (
+            "bad expression",
+            SMALL.replace("100*(1 - exp(-t))", "100*(1 - exq(-t))"),
+            "boundary.x_min.value",
+        ),
+        (
+            "wrong coordinates",
+            SMALL.replace("min = [0.0, 0.0]", "min = [0.0]"),
+            "domain.min",
+        ),
+        (
+            "spacing",
+            SMALL.replace("spacing = 0.05", "spacing = 0.03"),
+            "region[0].spacing",
+        ),
+        (
+            "unknown face",
+            SMALL.replace("[boundary.x_max]", "[boundary.z_max]"),
+            "boundary.z_max",
+        ),
+        ("not toml", "dimension = = 2".to_string(), "line 1"),
+        (
+            "output time",
+            SMALL.replace("outputs = [1.0, 2.0]", "outputs = [2.0, 1.0]"),
+            "time.outputs[1]",
+        ),
+    ];
+    for (what, text, key) in cases {
+        let case = write_case(dir.path(), "bad.toml", text);
+        let out = dir.path().join(format!("out_{}", what.replace(' ', "_")));
+        let o = peritherm(&["run", &case, "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{what}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{what}: {err}");
+        assert!(
+            err.contains("bad.toml") && err.contains(key),
+            "{what}: {err}"
+        );
+        assert!(
+            !err.contains("panicked") && !err.contains("backtrace"),
+            "{what}: {err}"
+        );
+        assert!(!out.exists(), "{what}: output written");
+    }
+    let o = peritherm(&["run", "/nonexistent/case.toml", "--out", "x"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/case.toml"));
+}
