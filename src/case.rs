@@ -259,6 +259,9 @@ pub struct ReferenceSpec {
     /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`.
     #[serde(default)]
     pub line_y: Option<f64>,
+    /// A point whose nearest body node is reported at every output (e.g. seed 000's midpoint), m.
+    #[serde(default)]
+    pub probe: Option<Vec<f64>>,
 }
 
 /// A validated case: the model spec plus run settings.
@@ -686,6 +689,11 @@ impl CaseFile {
                     &format!("time.outputs[{k}]"),
                     "output times must increase".into(),
                 ));
+            }
+        }
+        if let Some(r) = &self.reference {
+            if let Some(p) = &r.probe {
+                coords(p, "reference.probe")?;
             }
         }
         let geometry = BoxGeometry {

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use peritherm::case::Case;
 use peritherm::model::Model;
+use peritherm::output::RunSummary;
 use peritherm::run::run_case;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -36,6 +37,12 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+    },
+    /// Print a Markdown table comparing finished runs with their references.
+    Table {
+        /// Output directories of `peritherm run`.
+        #[arg(required = true)]
+        runs: Vec<PathBuf>,
     },
     /// Validate a case and print its size and stable time step without running it.
     Check {
@@ -96,6 +103,15 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                     "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
                     c.time, c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line
                 );
+            }
+            Ok(())
+        }
+        Command::Table { runs } => {
+            println!("{}", RunSummary::table_header());
+            for dir in runs {
+                for row in RunSummary::read(&dir)?.table_rows() {
+                    println!("{row}");
+                }
             }
             Ok(())
         }

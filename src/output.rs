@@ -5,7 +5,7 @@
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -44,7 +44,7 @@ pub fn field_csv(cloud: &Cloud, theta: &[f64]) -> String {
 }
 
 /// Comparison with a classical solution at one output time (formulation §9).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Comparison {
     /// Output time, s.
     pub time: f64,
@@ -58,10 +58,26 @@ pub struct Comparison {
     pub epsilon: f64,
     /// Nodes on the probe line.
     pub line_nodes: usize,
+    /// The body node nearest to the reference's probe point, if one is set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<Probe>,
+}
+
+/// Temperatures at one node, PD and classical.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Probe {
+    /// Node x, m.
+    pub x: f64,
+    /// Node y, m.
+    pub y: f64,
+    /// Peridynamic temperature, °C.
+    pub peridynamic: f64,
+    /// Classical temperature, °C.
+    pub classical: f64,
 }
 
 /// Summary written to run.json.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunSummary {
     /// Case title.
     pub title: String,
@@ -98,11 +114,58 @@ pub struct RunSummary {
     /// Rayon threads used.
     pub threads: usize,
     /// Comparison with the case's classical reference, per output time.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,
 }
 
 impl RunSummary {
+    /// Reads `dir/run.json`.
+    pub fn read(dir: &Path) -> Result<RunSummary> {
+        let path = dir.join("run.json");
+        let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
+            path: path.clone(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| Error::Io {
+            path,
+            source: std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()),
+        })
+    }
+
+    /// Markdown rows (one per output time) comparing this run with its reference.
+    pub fn table_rows(&self) -> Vec<String> {
+        let name = Path::new(&self.case)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        self.reference
+            .iter()
+            .map(|c| {
+                let probe = c
+                    .probe
+                    .as_ref()
+                    .map(|p| format!("{:.3} / {:.3}", p.peridynamic, p.classical))
+                    .unwrap_or_else(|| "-".into());
+                format!(
+                    "| {name} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {probe} | {} | {} | {:.1} |",
+                    c.time,
+                    self.nodes,
+                    c.max_abs_diff,
+                    c.mean_sq_rel_diff,
+                    c.l2_rel_line,
+                    self.bonds,
+                    self.steps,
+                    self.wall_seconds
+                )
+            })
+            .collect()
+    }
+
+    /// Header of [`RunSummary::table_rows`].
+    pub fn table_header() -> &'static str {
+        "| case | t (s) | nodes | max abs diff (°C) | eq 45 | eq 13 | probe PD / classical (°C) | bonds | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|"
+    }
+
     /// Writes run.json atomically.
     pub fn write(&self, dir: &Path) -> Result<()> {
         let json = serde_json::to_string_pretty(self).expect("plain data serialises");

@@ -1,19 +1,36 @@
 //! Measures that compare a run with a classical solution (formulation §9).
 
-use crate::analytic::Reference;
+use crate::case::ReferenceSpec;
 use crate::cloud::Cloud;
-use crate::output::Comparison;
+use crate::math::Point;
+use crate::output::{Comparison, Probe};
 
-/// Compares the body temperatures with `reference` at time `t`; `line_y` selects the
-/// probe line of seed 003 eq 13 (nodes within half a spacing of y = line_y).
-pub fn compare(
-    cloud: &Cloud,
-    theta: &[f64],
-    reference: &Reference,
-    line_y: Option<f64>,
-    t: f64,
-) -> Comparison {
+/// Compares the body temperatures with the case's reference at time `t`: over all nodes,
+/// along the probe line y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the
+/// body node nearest to `probe`.
+pub fn compare(cloud: &Cloud, theta: &[f64], spec: &ReferenceSpec, t: f64) -> Comparison {
+    let reference = &spec.solution;
+    let line_y = spec.line_y;
     let n = cloud.n_body;
+    let probe = spec.probe.as_ref().and_then(|c| {
+        let target = Point::new(
+            c.first().copied().unwrap_or(0.0),
+            c.get(1).copied().unwrap_or(0.0),
+            c.get(2).copied().unwrap_or(0.0),
+        );
+        let i = (0..n).min_by(|&a, &b| {
+            let da = (cloud.pos[a] - target).norm();
+            let db = (cloud.pos[b] - target).norm();
+            da.total_cmp(&db)
+        })?;
+        let p = cloud.pos[i];
+        Some(Probe {
+            x: p.x,
+            y: p.y,
+            peridynamic: theta[i],
+            classical: reference.eval(p.x, p.y, t),
+        })
+    });
     let classical: Vec<f64> = (0..n)
         .map(|i| reference.eval(cloud.pos[i].x, cloud.pos[i].y, t))
         .collect();
@@ -56,5 +73,6 @@ pub fn compare(
             0.0
         },
         line_nodes: n_line,
+        probe,
     }
 }

@@ -57,7 +57,7 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
                     .into_owned(),
             );
             if let Some(r) = &case.reference {
-                comparisons.push(compare(&model.cloud, th, &r.solution, r.line_y, t));
+                comparisons.push(compare(&model.cloud, th, r, t));
             }
             Ok(())
         },

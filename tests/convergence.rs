@@ -198,7 +198,14 @@ fn measures_follow_the_formulas() {
         .map(|p| r.solution.eval(p.x, 0.0, 1.0))
         .collect();
     let pd: Vec<f64> = exact.iter().map(|e| e * 1.01).collect();
-    let c = compare(&model.cloud, &pd, &r.solution, None, 1.0);
+    let mut r = r.clone();
+    r.line_y = None;
+    r.probe = Some(vec![5.0]);
+    let c = compare(&model.cloud, &pd, &r, 1.0);
+    let probe = c.probe.unwrap();
+    assert!(
+        (probe.x - 5.5).abs() < 1e-12 && (probe.peridynamic / probe.classical - 1.01).abs() < 1e-12
+    );
     assert!((c.mean_sq_rel_diff - 1e-4).abs() < 1e-12);
     assert!((c.l2_rel_line - 1e-2).abs() < 1e-12);
 }
