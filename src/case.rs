@@ -147,6 +147,9 @@ pub struct KernelSpec {
     /// Normalisation: continuum (exact integral, default) or lattice (midpoint sum).
     #[serde(default)]
     pub calibration: Calibration,
+    /// Symmetric correction of K that makes linear fields exact at horizon changes.
+    #[serde(default)]
+    pub linear_consistency: bool,
 }
 
 fn default_p() -> u8 {
@@ -167,6 +170,7 @@ impl Default for KernelSpec {
             partial_volume: default_pv(),
             bond_rule: BondRule::default(),
             calibration: Calibration::default(),
+            linear_consistency: false,
         }
     }
 }
@@ -719,6 +723,7 @@ impl CaseFile {
                 faces,
                 source,
                 initial,
+                linear_consistency: self.kernel.linear_consistency,
             },
             integrator: self.time.integrator,
             dt: self.time.dt,

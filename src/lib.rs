@@ -12,6 +12,7 @@ pub mod analytic;
 pub mod bc;
 pub mod case;
 pub mod cloud;
+pub mod consistency;
 pub mod error;
 pub mod expr;
 pub mod kernel;

@@ -2,6 +2,7 @@
 
 use crate::bc::{Boundary, BoundaryInput, FaceBc};
 use crate::cloud::{BoxGeometry, Cloud};
+use crate::consistency::{correct, Correction};
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Kernel, PartialVolume};
@@ -35,6 +36,8 @@ pub struct ModelSpec {
     pub source: Option<Expr>,
     /// Initial temperature.
     pub initial: Initial,
+    /// Correct K so that linear fields are exact at horizon changes ([`crate::consistency`]).
+    pub linear_consistency: bool,
 }
 
 /// An assembled model.
@@ -56,6 +59,8 @@ pub struct Model {
     pub boundary: Boundary,
     /// Initial temperature of every node, °C.
     pub theta0: Vec<f64>,
+    /// Result of the linear-consistency correction, when it was asked for.
+    pub correction: Option<Correction>,
 }
 
 impl Model {
@@ -111,7 +116,21 @@ impl Model {
             &conductivity,
             spec.bond_rule,
         );
-        let conductance = Conductance::assemble(&cloud, &horizons, &weights);
+        let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
+        let correction = if spec.linear_consistency {
+            // nodes whose bonds reach no face without a fictitious layer
+            let sel: Vec<bool> = (0..cloud.n_body)
+                .map(|i| {
+                    let reach = cloud.horizon[i] + cloud.spacing[i];
+                    (0..2 * cloud.dim)
+                        .filter(|&f| !spec.faces[f].needs_layer())
+                        .all(|f| cloud.distance_to_face(&cloud.pos[i], f) > reach)
+                })
+                .collect();
+            Some(correct(&mut conductance, &cloud, &sel, 1e-12, 20_000))
+        } else {
+            None
+        };
         let needs_micro = spec
             .faces
             .iter()
@@ -164,6 +183,7 @@ impl Model {
             inv_heat_capacity,
             boundary,
             theta0,
+            correction,
         })
     }
 

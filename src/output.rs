@@ -113,6 +113,10 @@ pub struct RunSummary {
     pub wall_seconds: f64,
     /// Rayon threads used.
     pub threads: usize,
+    /// Linear-consistency correction: max relative first moment before and after, CG
+    /// iterations, and the smallest factor applied to a pair conductance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub consistency: Option<[f64; 4]>,
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,

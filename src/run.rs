@@ -81,6 +81,9 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         setup_seconds,
         wall_seconds: t_run.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
+        consistency: model
+            .correction
+            .map(|c| [c.before, c.after, c.iterations as f64, c.min_ratio]),
         reference: comparisons,
     };
     summary.write(out)?;

@@ -115,17 +115,16 @@ fn square_dirichlet_follows_the_series() {
     }
 }
 
-/// Seed 004 §4.1, the dual-horizon plates at coarser spacings: every node within 1 % of the
-/// 10 °C span of the classical solution at 5 ms. The plates whose horizon doubles across the
-/// interface, (1, 2) and (0.5, 0.5), are coarsened least (Δ1 = 1.25e-4) because their interface
-/// error (formulation §2.2) grows with δ: 0.068 °C for (1, 2) at the case's Δ = 1e-4.
+/// Seed 004 §4.1, the dual-horizon plates at a 2.5× coarser spacing (Δ1 = 2.5e-4 m), as
+/// bundled (lattice calibration and linear-consistency correction): every node within 1 % of
+/// the 10 °C span of the classical solution at 5 ms, the paper's figure to meet.
 #[test]
 fn dual_horizon_plates_within_one_percent() {
     for (name, d1, d2, dt) in [
         ("dh_plate_k1_m1.toml", "2.5e-4", "2.5e-4", "6e-7"),
-        ("dh_plate_k1_m2.toml", "1.25e-4", "1.25e-4", "1.5e-7"),
+        ("dh_plate_k1_m2.toml", "2.5e-4", "2.5e-4", "6e-7"),
         ("dh_plate_k0.5_m1.toml", "2.5e-4", "5e-4", "6e-7"),
-        ("dh_plate_k0.5_m0.5.toml", "1.25e-4", "2.5e-4", "1.5e-7"),
+        ("dh_plate_k0.5_m0.5.toml", "2.5e-4", "5e-4", "6e-7"),
     ] {
         let text = std::fs::read_to_string(
             Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -200,7 +199,7 @@ fn measures_follow_the_formulas() {
     let pd: Vec<f64> = exact.iter().map(|e| e * 1.01).collect();
     let mut r = r.clone();
     r.line_y = None;
-    r.probe = Some(vec![5.0]);
+    r.probe = Some(vec![5.4]);
     let c = compare(&model.cloud, &pd, &r, 1.0);
     let probe = c.probe.unwrap();
     assert!(
