@@ -109,7 +109,6 @@ struct Ghost {
 #[derive(Debug, Clone)]
 struct Convective {
     nodes: Vec<(usize, f64)>,
-    h: f64,
     ambient: Expr,
 }
 
@@ -253,7 +252,6 @@ impl Boundary {
                         .collect();
                     b.convective.push(Convective {
                         nodes,
-                        h: *h,
                         ambient: ambient.clone(),
                     });
                 }
@@ -449,18 +447,8 @@ impl Boundary {
         d
     }
 
-    /// Convection coefficient sum h of all convective faces (for reporting), W/(m²·K).
-    pub fn convective_h(&self) -> f64 {
-        self.convective.iter().map(|c| c.h).sum()
-    }
-
     /// True when convection or a source adds to the rates.
     pub fn has_loads(&self) -> bool {
         !self.convective.is_empty() || self.source.is_some()
-    }
-
-    /// Number of fictitious nodes with a rule.
-    pub fn n_ghosts(&self) -> usize {
-        self.ghosts.len()
     }
 }
