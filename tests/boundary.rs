@@ -113,11 +113,11 @@ value = 6.0
     let mut theta = m.theta0.clone();
     m.boundary.apply(&m.cloud, &mut theta, 0.0);
     let mut n = 0;
-    for i in 0..m.cloud.n_body {
+    for (i, p) in m.cloud.pos.iter().enumerate().take(m.cloud.n_body) {
         if m.boundary.driven[i] {
-            let exact = 1.0 + 3.0 * m.cloud.pos[i].x;
+            let exact = 1.0 + 3.0 * p.x;
             // corner nodes see a truncated half-horizon along y; interior face nodes are exact
-            let y = m.cloud.pos[i].y;
+            let y = p.y;
             if y > 0.1 && y < 0.4 {
                 assert!(
                     (theta[i] - exact).abs() < 1e-12 * exact,
