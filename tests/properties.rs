@@ -126,11 +126,8 @@ fn linear_field_is_steady_in_the_bulk() {
     assert!(checked > 10);
 }
 
-/// With mirrored fictitious layers (Dirichlet on x, insulated on y) a linear field in x is
-/// steady at every body node, including those at the faces and corners (same tolerance).
-#[test]
-fn mirror_layers_keep_a_linear_field_steady_everywhere() {
-    let faces = r#"
+/// Mirrored layers holding 1 + 3x on the x faces of the 2 × 1 plate, insulated in y.
+const MIRROR_FACES: &str = r#"
 [boundary.x_min]
 type = "temperature"
 method = "mirror"
@@ -144,7 +141,12 @@ type = "insulated"
 [boundary.y_max]
 type = "insulated"
 "#;
-    let case = dual_horizon_case(faces, "lattice");
+
+/// With mirrored fictitious layers (Dirichlet on x, insulated on y) a linear field in x is
+/// steady at every body node, including those at the faces and corners (same tolerance).
+#[test]
+fn mirror_layers_keep_a_linear_field_steady_everywhere() {
+    let case = dual_horizon_case(MIRROR_FACES, "lattice");
     let mut spec = case.spec.clone();
     spec.geometry.regions.truncate(1);
     spec.geometry.regions[0].max[0] = 2.0;
@@ -241,21 +243,7 @@ fn time_step_bound() {
 /// flow scale (CG is run to 1e-12 relative).
 #[test]
 fn linear_consistency_correction_is_exact_and_conservative() {
-    let faces = r#"
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = 1.0
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 7.0
-[boundary.y_min]
-type = "insulated"
-[boundary.y_max]
-type = "insulated"
-"#;
-    let case = dual_horizon_case(faces, "lattice");
+    let case = dual_horizon_case(MIRROR_FACES, "lattice");
     let mut spec = case.spec.clone();
     spec.initial =
         peritherm::model::Initial::Field(peritherm::expr::Expr::parse("1 + 3*x").unwrap());
