@@ -108,6 +108,40 @@ fn slab(s: f64, l: f64, alpha: f64, t: f64) -> f64 {
 }
 
 impl Reference {
+    /// True when the solution varies with y as well as x.
+    pub fn depends_on_y(&self) -> bool {
+        matches!(self, Reference::SquareFixedEdges { .. })
+    }
+
+    /// The classical temperature at every point, evaluating each distinct (x, y) once
+    /// (in parallel), °C.
+    pub fn eval_many(&self, points: &[(f64, f64)], t: f64) -> Vec<f64> {
+        use rayon::prelude::*;
+        use std::collections::HashMap;
+        let key = |&(x, y): &(f64, f64)| {
+            (
+                x.to_bits(),
+                if self.depends_on_y() { y.to_bits() } else { 0 },
+            )
+        };
+        let mut index: HashMap<(u64, u64), usize> = HashMap::new();
+        let mut unique = Vec::new();
+        let slots: Vec<usize> = points
+            .iter()
+            .map(|p| {
+                *index.entry(key(p)).or_insert_with(|| {
+                    unique.push(*p);
+                    unique.len() - 1
+                })
+            })
+            .collect();
+        let values: Vec<f64> = unique
+            .par_iter()
+            .map(|&(x, y)| self.eval(x, y, t))
+            .collect();
+        slots.into_iter().map(|s| values[s]).collect()
+    }
+
     /// The classical temperature at a point and time, °C.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
         match *self {

@@ -92,6 +92,15 @@ pub fn correct(
             .fold(0.0, Real::max)
     };
     let before = measure(&m0);
+    if before <= 1e-13 {
+        // already consistent to round-off (no horizon change): nothing to correct
+        return Correction {
+            iterations: 0,
+            before,
+            after: before,
+            min_ratio: 1.0,
+        };
+    }
     // block-Jacobi preconditioner: the d×d diagonal blocks, identity on unused axes
     let precond: Vec<Matrix3<Real>> = (0..n)
         .into_par_iter()

@@ -109,8 +109,11 @@ pub struct RunSummary {
     pub energy: Vec<f64>,
     /// Seconds to build the model.
     pub setup_seconds: f64,
-    /// Seconds of time integration.
+    /// Seconds of time integration, output writing included, the reference comparison not.
     pub wall_seconds: f64,
+    /// Seconds spent evaluating the classical reference.
+    #[serde(default)]
+    pub reference_seconds: f64,
     /// Rayon threads used.
     pub threads: usize,
     /// Linear-consistency correction: max relative first moment before and after, CG

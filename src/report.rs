@@ -31,9 +31,8 @@ pub fn compare(cloud: &Cloud, theta: &[f64], spec: &ReferenceSpec, t: f64) -> Co
             classical: reference.eval(p.x, p.y, t),
         })
     });
-    let classical: Vec<f64> = (0..n)
-        .map(|i| reference.eval(cloud.pos[i].x, cloud.pos[i].y, t))
-        .collect();
+    let points: Vec<(f64, f64)> = cloud.pos[..n].iter().map(|p| (p.x, p.y)).collect();
+    let classical = reference.eval_many(&points, t);
     let mut max_abs: f64 = 0.0;
     let (mut sq_rel, mut n_rel) = (0.0, 0usize);
     let (mut sq, mut cmax) = (0.0, 0.0f64);

@@ -16,6 +16,7 @@ fn every_case_builds_and_starts() {
     names.sort();
     assert!(names.len() >= 13, "{names:?}");
     for path in names {
+        let started = std::time::Instant::now();
         let mut case = Case::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let model = Model::build(&case.spec).unwrap();
         let bound = case.integrator.stable_dt(&model);
@@ -33,5 +34,10 @@ fn every_case_builds_and_starts() {
         let s = run_case(&case, out.path(), |_, _| {}).unwrap();
         assert_eq!(s.steps, 3, "{}", path.display());
         assert!(out.path().join("field_1.csv").exists());
+        eprintln!(
+            "{}: {:.1} s",
+            path.display(),
+            started.elapsed().as_secs_f64()
+        );
     }
 }
