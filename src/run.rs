@@ -65,7 +65,21 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
             Ok(())
         },
         |s| progress(s, total),
-    )?;
+    )
+    .map_err(|e| match e {
+        Error::NonFinite { node, time } => {
+            let p = model.cloud.pos[node];
+            Error::Case {
+                file: case.path.clone(),
+                key: "state".into(),
+                message: format!(
+                    "temperature became non-finite near ({}, {}, {}) by t = {time:e} s; check source, boundary values and dt",
+                    p.x, p.y, p.z
+                ),
+            }
+        }
+        other => other,
+    })?;
     let summary = RunSummary {
         title: case.title.clone(),
         case: case.path.display().to_string(),

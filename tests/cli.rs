@@ -152,6 +152,36 @@ fn bad_input_fails_with_one_clear_line() {
         );
         assert!(!out.exists(), "{what}: output written");
     }
+    // NaN in the initial state: refused before anything is written
+    let case = write_case(
+        dir.path(),
+        "nan.toml",
+        &SMALL.replace("[time]", "[initial]\nvalue = \"ln(x - 1)\"\n[time]"),
+    );
+    let out = dir.path().join("out_nan");
+    let o = peritherm(&["run", &case, "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("nan.toml") && err.contains("initial") && !out.exists(),
+        "{err}"
+    );
+    // NaN that appears during the run: one line, no run.json, no partial file
+    let case = write_case(
+        dir.path(),
+        "inf.toml",
+        &SMALL.replace("[time]", "[source]\nvalue = \"1/(x - 0.025)\"\n[time]"),
+    );
+    let out = dir.path().join("out_inf");
+    let o = peritherm(&["run", &case, "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("inf.toml") && err.contains("non-finite"),
+        "{err}"
+    );
+    assert!(!out.join("run.json").exists());
     let o = peritherm(&["run", "/nonexistent/case.toml", "--out", "x"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/case.toml"));
