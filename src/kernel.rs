@@ -150,7 +150,7 @@ impl Kernel {
         }
     }
 
-    /// Micro-conductance c = C w(at/δ) / r^p, W/(K·m^(3+? )) per unit volume squared.
+    /// Micro-conductance c = C w(at/δ) / r^p, W/(K·m⁶): K_ij = V_i V_j c is in W/K.
     pub fn micro(&self, c_norm: f64, r: f64, at: f64, delta: f64) -> f64 {
         let w = match self.profile {
             Profile::Constant => 1.0,
