@@ -164,9 +164,10 @@ impl Conductance {
     #[inline]
     pub fn row_flow(&self, i: usize, theta: &[f64]) -> f64 {
         let ti = theta[i];
+        let row = self.offsets[i]..self.offsets[i + 1];
         let mut s = 0.0;
-        for b in self.offsets[i]..self.offsets[i + 1] {
-            s += self.vals[b] * (theta[self.cols[b] as usize] - ti);
+        for (&j, &k) in self.cols[row.clone()].iter().zip(&self.vals[row]) {
+            s += k * (theta[j as usize] - ti);
         }
         s
     }
