@@ -141,6 +141,11 @@ impl BoxRegion {
     fn h(&self, a: usize) -> f64 {
         (self.max[a] - self.min[a]) / self.cells[a] as f64
     }
+
+    /// Node spacing Δ of the region's lattice (cells are square), m.
+    pub fn spacing(&self) -> f64 {
+        self.h(0)
+    }
 }
 
 /// A built-in geometry: a box domain tiled by box regions.

@@ -91,19 +91,14 @@ impl Model {
             PartialVolume::AllOrNothing => 0.0,
             PartialVolume::Algorithm1 => 0.5,
         };
-        let layer = g
+        // one horizon plus the partial-volume band of the coarsest spacing
+        let max_spacing = g.regions.iter().map(|r| r.spacing()).fold(0.0, f64::max);
+        let max_horizon = g
             .regions
             .iter()
-            .map(|r| {
-                let h = (r.max[0] - r.min[0]) / r.cells[0] as f64;
-                r.horizon.horizon(h)
-            })
-            .fold(0.0, f64::max)
-            + band
-                * g.regions
-                    .iter()
-                    .map(|r| (r.max[0] - r.min[0]) / r.cells[0] as f64)
-                    .fold(0.0, f64::max);
+            .map(|r| r.horizon.horizon(r.spacing()))
+            .fold(0.0, f64::max);
+        let layer = max_horizon + band * max_spacing;
         let cloud = g.generate(mask, layer)?;
         let mat = |i: usize| spec.materials[cloud.material[i] as usize];
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
