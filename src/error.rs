@@ -32,7 +32,7 @@ pub enum Error {
         message: String,
     },
     /// A time step above the stability bound of formulation §4.
-    #[error("time.dt = {dt:e} s exceeds the stable bound {bound:e} s of the {integrator} integrator (formulation §4); use time.dt <= {bound:e} or omit it")]
+    #[error("{dt:.4e} s exceeds the stable bound {bound:.4e} s of the {integrator} integrator (formulation §4); use a smaller time.dt or omit it")]
     UnstableDt {
         /// The requested step, s.
         dt: f64,
@@ -50,12 +50,12 @@ pub enum Error {
         time: f64,
     },
     /// Output could not be written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file or directory.
         path: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
+        /// The underlying error (shown in the message, so not chained as a source).
+        error: std::io::Error,
     },
 }
 

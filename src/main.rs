@@ -7,6 +7,7 @@ use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::output::RunSummary;
 use peritherm::run::run_case;
+use peritherm::solve::explicit::choose_dt;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -129,13 +130,8 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 case.integrator.name(),
                 bound
             );
-            if let Some(dt) = case.dt {
-                if dt > bound {
-                    anyhow::bail!(
-                        "{}: time.dt: {dt:e} s exceeds the stable bound {bound:e} s",
-                        case.path.display()
-                    );
-                }
+            if let Err(e) = choose_dt(&model, case.integrator, case.dt) {
+                anyhow::bail!("{}: time.dt: {e}", case.path.display());
             }
             Ok(())
         }

@@ -18,7 +18,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_file_name(format!(".{name}.partial"));
     let io = |source| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error: source,
     };
     std::fs::write(&tmp, bytes).map_err(io)?;
     std::fs::rename(&tmp, path).map_err(io)
@@ -129,13 +129,13 @@ impl RunSummary {
     /// Reads `dir/run.json`.
     pub fn read(dir: &Path) -> Result<RunSummary> {
         let path = dir.join("run.json");
-        let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
+        let text = std::fs::read_to_string(&path).map_err(|error| Error::Io {
             path: path.clone(),
-            source,
+            error,
         })?;
         serde_json::from_str(&text).map_err(|e| Error::Io {
             path,
-            source: std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()),
         })
     }
 

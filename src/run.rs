@@ -29,9 +29,9 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         other => other,
     })?;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
-    std::fs::create_dir_all(out).map_err(|source| Error::Io {
+    std::fs::create_dir_all(out).map_err(|error| Error::Io {
         path: out.to_path_buf(),
-        source,
+        error,
     })?;
     let total = count_steps(0.0, &case.outputs, dt);
     let mut theta = model.theta0.clone();
