@@ -122,7 +122,17 @@ impl Model {
                         .all(|f| cloud.distance_to_face(&cloud.pos[i], f) > reach)
                 })
                 .collect();
-            Some(correct(&mut conductance, &cloud, &sel, 1e-12, 20_000))
+            let c = correct(&mut conductance, &cloud, &sel, 1e-12, 20_000);
+            if c.min_ratio <= 0.0 {
+                return Err(Error::model(
+                    "kernel.linear_consistency",
+                    format!(
+                        "the correction would make a pair conductance negative (factor {:.3}): the change of horizon is too abrupt; grade it over more regions or set linear_consistency = false",
+                        c.min_ratio
+                    ),
+                ));
+            }
+            Some(c)
         } else {
             None
         };

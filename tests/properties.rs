@@ -342,3 +342,17 @@ end = 1.0
     }
     assert!(((m.energy(&theta) - e0) / e0).abs() <= 1e-12);
 }
+
+/// Where the horizon jumps too abruptly (here by 4×) the correction would need negative
+/// conductances; the model is refused with a message naming the key instead.
+#[test]
+fn linear_consistency_refuses_negative_conductances() {
+    let mut spec = dual_horizon_case(MIRROR_FACES, "lattice").spec;
+    spec.geometry.regions[0].horizon = peritherm::cloud::HorizonRule::Factor(1.5);
+    spec.linear_consistency = true;
+    let err = Model::build(&spec).unwrap_err().to_string();
+    assert!(
+        err.contains("kernel.linear_consistency") && err.contains("negative"),
+        "{err}"
+    );
+}
