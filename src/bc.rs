@@ -5,7 +5,7 @@
 //! fictitious layers of seed 004 / seed 001); loads add to the rates (convection of
 //! seed 001, volumetric sources).
 
-use crate::cloud::{Cloud, Face};
+use crate::cloud::{inward, Cloud, Face};
 use crate::expr::Expr;
 use crate::math::{NodeId, Point};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -147,24 +147,14 @@ pub struct BoundaryInput<'a> {
 
 fn project(cloud: &Cloud, p: &Point, face: Face) -> Point {
     let mut q = *p;
-    let a = face / 2;
-    q[a] = if face.is_multiple_of(2) {
-        cloud.min[a]
-    } else {
-        cloud.max[a]
-    };
+    q[face / 2] = cloud.face_plane(face);
     q
 }
 
 fn reflect(cloud: &Cloud, p: &Point, face: Face) -> Point {
     let mut q = *p;
     let a = face / 2;
-    let plane = if face.is_multiple_of(2) {
-        cloud.min[a]
-    } else {
-        cloud.max[a]
-    };
-    q[a] = 2.0 * plane - p[a];
+    q[a] = 2.0 * cloud.face_plane(face) - p[a];
     q
 }
 
@@ -216,13 +206,13 @@ impl Boundary {
                         .micro
                         .expect("micro-conductances are given for nodal flux relations");
                     let a = face / 2;
-                    let inward = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+                    let sign = inward(face);
                     for i in cloud.face_layer(face, 1.0) {
                         let mut stencil = Vec::new();
                         let mut wsum = 0.0;
                         for bnd in h.row(i) {
                             let j = h.targets[bnd] as usize;
-                            let l = (cloud.pos[j][a] - cloud.pos[i][a]) * inward;
+                            let l = (cloud.pos[j][a] - cloud.pos[i][a]) * sign;
                             if l > 0.0 && j < nb {
                                 let w = micro[bnd] * l;
                                 stencil.push((j as NodeId, w));

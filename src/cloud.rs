@@ -13,6 +13,15 @@ pub const FACE_NAMES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", 
 /// Index of a face (0..6): axis = face / 2, max side when face is odd.
 pub type Face = usize;
 
+/// Direction of the body seen from a face along its axis: +1 for a min face, −1 for a max face.
+pub fn inward(face: Face) -> f64 {
+    if face.is_multiple_of(2) {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 /// Struct-of-arrays node cloud.
 #[derive(Debug, Clone, Default)]
 pub struct Cloud {
@@ -62,11 +71,16 @@ impl Cloud {
 
     /// Signed distance of a point inside the body to a face of the bounding box, m.
     pub fn distance_to_face(&self, p: &Point, face: Face) -> f64 {
+        (p[face / 2] - self.face_plane(face)) * inward(face)
+    }
+
+    /// Coordinate of a face's plane along its axis, m.
+    pub fn face_plane(&self, face: Face) -> f64 {
         let a = face / 2;
         if face.is_multiple_of(2) {
-            p[a] - self.min[a]
+            self.min[a]
         } else {
-            self.max[a] - p[a]
+            self.max[a]
         }
     }
 

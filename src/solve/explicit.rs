@@ -70,12 +70,18 @@ pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Re
     }
 }
 
+/// Steps from `t` to `to` when no step may exceed `dt` (a relative 1e-12 slack keeps
+/// round-off from adding a step).
+fn steps_between(t: f64, to: f64, dt: f64) -> u64 {
+    ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64
+}
+
 /// Number of steps from `t0` to each output time with steps no longer than `dt`.
 pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
     let mut t = t0;
     let mut n = 0;
     for &to in outputs {
-        n += ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+        n += steps_between(t, to, dt);
         t = to;
     }
     n
@@ -190,7 +196,7 @@ impl<'a> Explicit<'a> {
         let mut t = t0;
         let mut stats = RunStats::default();
         for (k, &to) in outputs.iter().enumerate() {
-            let n = ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+            let n = steps_between(t, to, dt);
             let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
             for s in 0..n {
                 let tn = t + s as f64 * h;
