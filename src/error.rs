@@ -49,6 +49,14 @@ pub enum Error {
         /// Simulation time, s.
         time: f64,
     },
+    /// A mesh file that cannot be read or does not describe a usable body.
+    #[error("{path}: {message}")]
+    Mesh {
+        /// The mesh file.
+        path: PathBuf,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
     /// Output could not be written.
     #[error("{path}: {error}")]
     Io {
