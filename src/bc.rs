@@ -5,11 +5,10 @@
 //! fictitious layers of seed 004 / seed 001); loads add to the rates (convection of
 //! seed 001, volumetric sources).
 
-use crate::cloud::{inward, Cloud, Face};
+use crate::cloud::{Cloud, Fictitious, Reflection};
 use crate::expr::Expr;
 use crate::math::{NodeId, Point};
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use std::num::NonZero;
+use crate::spatial::PointIndex;
 
 /// How a fictitious layer takes its temperature from the body (formulation §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,7 +19,7 @@ pub enum Layer {
     Mirror,
 }
 
-/// The condition on one face of a box geometry.
+/// The condition on one boundary set (a box face or a mesh's physical group).
 #[derive(Debug, Clone, PartialEq)]
 pub enum FaceBc {
     /// No bonds leave the body: insulated with the surface skin effect (seed 003 §3.5).
@@ -96,13 +95,13 @@ struct RelationNodal {
     value: Expr,
 }
 
-/// One fictitious node's rule: θ_f = σ θ(mirror) + Σ coef · g_face(t, d).
+/// One fictitious node's rule: θ_f = σ θ(mirror) + Σ coef · g_set(t, d) at a foot point.
 #[derive(Debug, Clone)]
 struct Ghost {
     node: usize,
     sigma: f64,
     stencil: Vec<(NodeId, f64)>,
-    terms: Vec<(Face, f64, f64, Point)>,
+    terms: Vec<(usize, f64, f64, Point)>,
 }
 
 /// Convection on surface nodes.
@@ -133,7 +132,7 @@ pub struct Boundary {
 pub struct BoundaryInput<'a> {
     /// The cloud, with fictitious nodes already generated.
     pub cloud: &'a Cloud,
-    /// Per-face conditions (6 entries, unused axes Free).
+    /// Conditions by boundary set (box: the 6 faces, unused axes Free).
     pub faces: Vec<FaceBc>,
     /// Conductivity per node, W/(m·K).
     pub conductivity: &'a [f64],
@@ -143,19 +142,6 @@ pub struct BoundaryInput<'a> {
     pub micro: Option<(&'a crate::neighbors::Horizons, &'a [f64])>,
     /// Volumetric source, W/m³.
     pub source: Option<Expr>,
-}
-
-fn project(cloud: &Cloud, p: &Point, face: Face) -> Point {
-    let mut q = *p;
-    q[face / 2] = cloud.face_plane(face);
-    q
-}
-
-fn reflect(cloud: &Cloud, p: &Point, face: Face) -> Point {
-    let mut q = *p;
-    let a = face / 2;
-    q[a] = 2.0 * cloud.face_plane(face) - p[a];
-    q
 }
 
 impl Boundary {
@@ -172,7 +158,7 @@ impl Boundary {
         for (face, bc) in input.faces.iter().enumerate() {
             match bc {
                 FaceBc::NodalTemperature { value, layers } => {
-                    let nodes = cloud.face_layer(face, *layers);
+                    let nodes = cloud.set_layer(face, *layers);
                     b.nodal.push(Nodal {
                         nodes,
                         value: value.clone(),
@@ -183,7 +169,7 @@ impl Boundary {
                     let mut anchor = None;
                     let mut best = f64::INFINITY;
                     for i in 0..nb {
-                        let d = cloud.distance_to_face(&cloud.pos[i], face);
+                        let d = cloud.set_distance(&cloud.pos[i], face);
                         if d < cloud.horizon[i] * (1.0 - 1e-9) {
                             slaved.push((i, d));
                         } else if d < best {
@@ -197,7 +183,7 @@ impl Boundary {
                             anchor: a,
                             value: value.clone(),
                             conductivity: input.conductivity[a],
-                            at: project(cloud, &cloud.pos[a], face),
+                            at: cloud.set_foot(&cloud.pos[a], face).0,
                         });
                     }
                 }
@@ -205,14 +191,13 @@ impl Boundary {
                     let (h, micro) = input
                         .micro
                         .expect("micro-conductances are given for nodal flux relations");
-                    let a = face / 2;
-                    let sign = inward(face);
-                    for i in cloud.face_layer(face, 1.0) {
+                    for i in cloud.set_layer(face, 1.0) {
+                        let normal = cloud.set_foot(&cloud.pos[i], face).1;
                         let mut stencil = Vec::new();
                         let mut wsum = 0.0;
                         for bnd in h.row(i) {
                             let j = h.targets[bnd] as usize;
-                            let l = (cloud.pos[j][a] - cloud.pos[i][a]) * sign;
+                            let l = (cloud.pos[j] - cloud.pos[i]).dot(&normal);
                             if l > 0.0 && j < nb {
                                 let w = micro[bnd] * l;
                                 stencil.push((j as NodeId, w));
@@ -231,14 +216,9 @@ impl Boundary {
                 }
                 FaceBc::Convection { h, ambient } => {
                     let nodes = cloud
-                        .face_layer(face, 1.0)
+                        .exposed(face)
                         .into_iter()
-                        .map(|i| {
-                            (
-                                i,
-                                *h * cloud.exposed_area(i) / (cloud.volume[i] * input.capacity[i]),
-                            )
-                        })
+                        .map(|(i, area)| (i, *h * area / (cloud.volume[i] * input.capacity[i])))
                         .collect();
                     b.convective.push(Convective {
                         nodes,
@@ -275,78 +255,93 @@ impl Boundary {
         b
     }
 
-    fn build_ghosts(&mut self, cloud: &Cloud, conductivity: &[f64]) {
-        if cloud.n_fictitious() == 0 {
-            return;
+    /// θ_f = σ θ(image) + Σ coef·g along a chain of reflections (outermost first).
+    fn compose(&self, chain: &[Reflection], k: f64) -> (f64, Vec<(usize, f64, f64, Point)>) {
+        let mut s = 1.0;
+        let mut terms = Vec::new();
+        for r in chain {
+            let (sigma, coef) = match &self.faces[r.set] {
+                FaceBc::LayerTemperature {
+                    layer: Layer::Naive,
+                    ..
+                } => (0.0, 1.0),
+                FaceBc::LayerTemperature {
+                    layer: Layer::Mirror,
+                    ..
+                } => (-1.0, 2.0),
+                FaceBc::LayerFlux { .. } => (1.0, 1.0 / k),
+                _ => (1.0, 0.0),
+            };
+            if coef != 0.0 && s != 0.0 {
+                terms.push((r.set, s * coef, r.distance, r.foot));
+            }
+            s *= sigma;
         }
-        let body: Vec<[f64; 3]> = cloud.pos[..cloud.n_body]
-            .iter()
-            .map(|p| [p.x, p.y, p.z])
-            .collect();
-        if body.is_empty() {
-            return;
-        }
-        let tree: ImmutableKdTree<f64, 3> =
-            ImmutableKdTree::new_from_slice(&body).expect("non-empty body");
-        let k_near = NonZero::new(1usize << cloud.dim).expect("non-zero");
-        for f in 0..cloud.n_fictitious() {
-            let node = cloud.n_body + f;
-            let mask = cloud.outside[f];
-            // naive faces first: they fix the value whatever follows
-            let mut faces: Vec<Face> = (0..6).filter(|&fc| mask & (1 << fc) != 0).collect();
-            faces.sort_by_key(|&fc| {
-                !matches!(
-                    self.faces[fc],
-                    FaceBc::LayerTemperature {
-                        layer: Layer::Naive,
-                        ..
-                    }
-                )
+        (s, terms)
+    }
+
+    /// Lattice ghosts of a box: reflections across the faces the node lies outside of
+    /// (naive faces first: they fix the value whatever follows), ending at a point in the body.
+    fn lattice_chain(&self, cloud: &Cloud, node: usize, outside: u8) -> (Vec<Reflection>, Point) {
+        let mut faces: Vec<usize> = (0..6).filter(|&fc| outside & (1 << fc) != 0).collect();
+        faces.sort_by_key(|&fc| {
+            !matches!(
+                self.faces[fc],
+                FaceBc::LayerTemperature {
+                    layer: Layer::Naive,
+                    ..
+                }
+            )
+        });
+        let mut p = cloud.pos[node];
+        let mut chain = Vec::new();
+        for set in faces {
+            let (foot, _) = cloud.set_foot(&p, set);
+            let q = p + (foot - p) * 2.0;
+            chain.push(Reflection {
+                set,
+                foot,
+                distance: (q - p).norm(),
             });
-            let mut p = cloud.pos[node];
-            let mut s = 1.0;
-            let mut terms = Vec::new();
-            for &fc in &faces {
-                let q = reflect(cloud, &p, fc);
-                let d = (q - p).norm();
-                let (sigma, coef) = match &self.faces[fc] {
-                    FaceBc::LayerTemperature {
-                        layer: Layer::Naive,
-                        ..
-                    } => (0.0, 1.0),
-                    FaceBc::LayerTemperature {
-                        layer: Layer::Mirror,
-                        ..
-                    } => (-1.0, 2.0),
-                    FaceBc::LayerFlux { .. } => (1.0, 1.0 / conductivity[node]),
-                    _ => (1.0, 0.0),
-                };
-                if coef != 0.0 && s != 0.0 {
-                    terms.push((fc, s * coef, d, project(cloud, &p, fc)));
+            p = q;
+        }
+        (chain, p)
+    }
+
+    fn build_ghosts(&mut self, cloud: &Cloud, conductivity: &[f64]) {
+        if cloud.n_fictitious() == 0 || cloud.n_body == 0 {
+            return;
+        }
+        let body = PointIndex::new(&cloud.pos[..cloud.n_body]);
+        for (f, origin) in cloud.fictitious.iter().enumerate() {
+            let node = cloud.n_body + f;
+            let (sigma, terms, stencil) = match origin {
+                Fictitious::Mirror { of, chain } => {
+                    let (sigma, terms) = self.compose(chain, conductivity[node]);
+                    (sigma, terms, vec![(*of, 1.0)])
                 }
-                s *= sigma;
-                p = q;
-            }
-            let mut stencil = Vec::new();
-            if s != 0.0 {
-                let near = tree
-                    .query(&[p.x, p.y, p.z])
-                    .nearest_n::<SquaredEuclidean<f64>>(k_near)
-                    .execute();
-                let exact = near[0].distance.sqrt() <= 1e-6 * cloud.spacing[node];
-                if exact {
-                    stencil.push((near[0].item as NodeId, 1.0));
-                } else {
-                    let ws: Vec<f64> = near.iter().map(|it| 1.0 / it.distance.sqrt()).collect();
-                    let tot: f64 = ws.iter().sum();
-                    for (it, w) in near.iter().zip(ws) {
-                        stencil.push((it.item as NodeId, w / tot));
+                Fictitious::Lattice { outside } => {
+                    let (chain, image) = self.lattice_chain(cloud, node, *outside);
+                    let (sigma, terms) = self.compose(&chain, conductivity[node]);
+                    let mut stencil = Vec::new();
+                    if sigma != 0.0 {
+                        // the image's value: the node there, or inverse-distance weights
+                        let near = body.nearest(&image, 1 << cloud.dim);
+                        if near[0].1 <= 1e-6 * cloud.spacing[node] {
+                            stencil.push((near[0].0 as NodeId, 1.0));
+                        } else {
+                            let tot: f64 = near.iter().map(|n| 1.0 / n.1).sum();
+                            for (j, d) in near {
+                                stencil.push((j as NodeId, 1.0 / d / tot));
+                            }
+                        }
                     }
+                    (sigma, terms, stencil)
                 }
-            }
+            };
             self.ghosts.push(Ghost {
                 node,
-                sigma: s,
+                sigma,
                 stencil,
                 terms,
             });

@@ -5,12 +5,14 @@
 
 use crate::analytic::Reference;
 use crate::bc::{FaceBc, Layer};
+use crate::cloud::mesh::{MeshGeometry, MeshRegion};
 use crate::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use crate::material::{BondRule, Material};
-use crate::model::{Initial, ModelSpec};
+use crate::math::Point;
+use crate::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
 use crate::solve::explicit::Integrator;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -35,10 +37,17 @@ pub struct CaseFile {
     pub title: String,
     /// Spatial dimension, 1..=3.
     pub dimension: usize,
-    /// The box domain.
-    pub domain: DomainSpec,
-    /// Regions tiling the domain (at least one).
+    /// The built-in box domain (or give `mesh`).
+    #[serde(default)]
+    pub domain: Option<DomainSpec>,
+    /// A gmsh mesh (or give `domain`).
+    #[serde(default)]
+    pub mesh: Option<MeshSpec>,
+    /// Regions: boxes tiling the domain, or the mesh's physical groups (at least one).
     pub region: Vec<RegionSpec>,
+    /// Pre-cracks.
+    #[serde(default)]
+    pub crack: Vec<CrackSpec>,
     /// Materials by name.
     pub material: BTreeMap<String, Material>,
     /// Kernel settings.
@@ -77,6 +86,41 @@ pub struct DomainSpec {
     /// `cell` (cell-centred nodes of equal volume) or `boundary` (nodes on the boundary).
     #[serde(default)]
     pub placement: Placement,
+}
+
+/// `[mesh]`: a gmsh MSH 4.1 file whose elements become nodes.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Path of the .msh file, relative to the case file.
+    pub file: PathBuf,
+    /// Metres per mesh unit (default 1).
+    #[serde(default)]
+    pub scale: Option<f64>,
+    /// Thickness h of a 2D body, m.
+    #[serde(default)]
+    pub thickness: Option<f64>,
+    /// Cross-section A of a 1D bar, m².
+    #[serde(default)]
+    pub area: Option<f64>,
+    /// Largest ratio of horizons between neighbouring nodes (> 1); larger ones are reduced.
+    #[serde(default)]
+    pub horizon_ratio: Option<f64>,
+}
+
+/// `[[crack]]`: a pre-crack along a mesh group or a polyline.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrackSpec {
+    /// A mesh physical group (curves in 2D, surfaces in 3D) embedded in the body.
+    #[serde(default)]
+    pub group: Option<String>,
+    /// A 2D polyline, m.
+    #[serde(default)]
+    pub points: Option<Vec<Vec<f64>>>,
+    /// Conductance fraction μ kept across the crack (default 0: insulated).
+    #[serde(default)]
+    pub conductance: Option<f64>,
 }
 
 /// Node placement.
@@ -346,31 +390,45 @@ fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
     }
 }
 
-impl CaseFile {
-    fn validate(self, path: &Path) -> Result<Case> {
-        let err = |key: &str, m: String| case_err(path, key, m);
-        let dim = self.dimension;
-        if !(1..=3).contains(&dim) {
-            return Err(err("dimension", format!("must be 1, 2 or 3, got {dim}")));
+fn coords(path: &Path, dim: usize, v: &[f64], key: &str) -> Result<[f64; 3]> {
+    if v.len() != dim {
+        return Err(case_err(
+            path,
+            key,
+            format!("needs {dim} coordinates, got {}", v.len()),
+        ));
+    }
+    let mut p = [0.0; 3];
+    for (a, x) in v.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(case_err(path, key, "coordinates must be finite"));
         }
-        let coords = |v: &[f64], key: &str| -> Result<[f64; 3]> {
-            if v.len() != dim {
-                return Err(err(
-                    key,
-                    format!("needs {dim} coordinates, got {}", v.len()),
-                ));
-            }
-            let mut p = [0.0; 3];
-            for (a, x) in v.iter().enumerate() {
-                if !x.is_finite() {
-                    return Err(err(key, "coordinates must be finite".into()));
-                }
-                p[a] = *x;
-            }
-            Ok(p)
-        };
-        let dmin = coords(&self.domain.min, "domain.min")?;
-        let dmax = coords(&self.domain.max, "domain.max")?;
+        p[a] = *x;
+    }
+    Ok(p)
+}
+
+/// Keys a [`Error::Model`] from geometry validation to the case file.
+fn in_case(path: &Path, e: Error) -> Error {
+    match e {
+        Error::Model { key, message } => case_err(path, &key, message),
+        other => other,
+    }
+}
+
+impl CaseFile {
+    /// The built-in box geometry of `[domain]` and the `[[region]]` boxes.
+    fn box_geometry(
+        &self,
+        path: &Path,
+        d: &DomainSpec,
+        tau: f64,
+        rules: &[(HorizonRule, u16)],
+    ) -> Result<BoxGeometry> {
+        let dim = self.dimension;
+        let err = |key: &str, m: String| case_err(path, key, m);
+        let dmin = coords(path, dim, &d.min, "domain.min")?;
+        let dmax = coords(path, dim, &d.max, "domain.max")?;
         for a in 0..dim {
             if dmax[a] <= dmin[a] {
                 return Err(err(
@@ -379,74 +437,15 @@ impl CaseFile {
                 ));
             }
         }
-        let tau = match dim {
-            1 => {
-                if self.domain.thickness.is_some() {
-                    return Err(err(
-                        "domain.thickness",
-                        "is for 2D; a 1D bar takes domain.area".into(),
-                    ));
-                }
-                positive(path, "domain.area", self.domain.area.unwrap_or(1.0))?
-            }
-            2 => {
-                if self.domain.area.is_some() {
-                    return Err(err(
-                        "domain.area",
-                        "is for 1D; a 2D body takes domain.thickness".into(),
-                    ));
-                }
-                positive(
-                    path,
-                    "domain.thickness",
-                    self.domain.thickness.unwrap_or(1.0),
-                )?
-            }
-            _ => {
-                if self.domain.area.is_some() || self.domain.thickness.is_some() {
-                    return Err(err(
-                        "domain",
-                        "a 3D body takes neither area nor thickness".into(),
-                    ));
-                }
-                1.0
-            }
-        };
-        if self.material.is_empty() {
-            return Err(err(
-                "material",
-                "define at least one [material.<name>]".into(),
-            ));
-        }
-        let names: Vec<&String> = self.material.keys().collect();
-        let mut materials = Vec::new();
-        for (name, m) in &self.material {
-            positive(
-                path,
-                &format!("material.{name}.conductivity"),
-                m.conductivity,
-            )?;
-            positive(path, &format!("material.{name}.density"), m.density)?;
-            positive(
-                path,
-                &format!("material.{name}.specific_heat"),
-                m.specific_heat,
-            )?;
-            materials.push(*m);
-        }
-        if self.region.is_empty() {
-            return Err(err("region", "define at least one [[region]]".into()));
-        }
         let mut regions = Vec::new();
-        let mut per_region_initial = Vec::new();
         for (r, reg) in self.region.iter().enumerate() {
             let key = |k: &str| format!("region[{r}].{k}");
             let rmin = match &reg.min {
-                Some(v) => coords(v, &key("min"))?,
+                Some(v) => coords(path, dim, v, &key("min"))?,
                 None => dmin,
             };
             let rmax = match &reg.max {
-                Some(v) => coords(v, &key("max"))?,
+                Some(v) => coords(path, dim, v, &key("max"))?,
                 None => dmax,
             };
             for a in 0..dim {
@@ -492,6 +491,265 @@ impl CaseFile {
                     cells[..dim].copy_from_slice(c);
                 }
             }
+            regions.push(BoxRegion {
+                name: reg.name.clone(),
+                min: rmin,
+                max: rmax,
+                cells,
+                horizon: rules[r].0,
+                material: rules[r].1,
+            });
+        }
+        let g = BoxGeometry {
+            dim,
+            tau,
+            min: dmin,
+            max: dmax,
+            boundary_placement: d.placement == Placement::Boundary,
+            regions,
+        };
+        g.validate().map_err(|e| in_case(path, e))?;
+        Ok(g)
+    }
+
+    /// The geometry of `[mesh]`: reads the gmsh file and maps `[[region]]` names to groups.
+    fn mesh_geometry(
+        &self,
+        path: &Path,
+        m: &MeshSpec,
+        tau: f64,
+        rules: &[(HorizonRule, u16)],
+    ) -> Result<MeshGeometry> {
+        let dim = self.dimension;
+        let file = path.parent().unwrap_or(Path::new(".")).join(&m.file);
+        let mesh =
+            crate::gmsh::read(&file).map_err(|e| case_err(path, "mesh.file", e.to_string()))?;
+        if mesh.dim() != dim {
+            return Err(case_err(
+                path,
+                "dimension",
+                format!(
+                    "is {dim} but the mesh {} has {}D elements",
+                    file.display(),
+                    mesh.dim()
+                ),
+            ));
+        }
+        let scale = positive(path, "mesh.scale", m.scale.unwrap_or(1.0))?;
+        if let Some(r) = m.horizon_ratio {
+            if !(r.is_finite() && r > 1.0) {
+                return Err(case_err(
+                    path,
+                    "mesh.horizon_ratio",
+                    format!("must be a number > 1, got {r}"),
+                ));
+            }
+        }
+        let mut regions = Vec::new();
+        for (r, reg) in self.region.iter().enumerate() {
+            let key = |k: &str| format!("region[{r}].{k}");
+            for (k, present) in [
+                ("min", reg.min.is_some()),
+                ("max", reg.max.is_some()),
+                ("spacing", reg.spacing.is_some()),
+                ("cells", reg.cells.is_some()),
+            ] {
+                if present {
+                    return Err(case_err(
+                        path,
+                        &key(k),
+                        "does not apply to a mesh: the elements give positions and spacings",
+                    ));
+                }
+            }
+            let group = mesh.group(dim, &reg.name).ok_or_else(|| {
+                let have: Vec<&str> = mesh
+                    .groups
+                    .iter()
+                    .filter(|g| g.dim == dim)
+                    .map(|g| g.name.as_str())
+                    .collect();
+                case_err(
+                    path,
+                    &key("name"),
+                    format!(
+                        "`{}` is not a {dim}D physical group of the mesh; it has {have:?}",
+                        reg.name
+                    ),
+                )
+            })?;
+            regions.push(MeshRegion {
+                name: reg.name.clone(),
+                group,
+                horizon: rules[r].0,
+                material: rules[r].1,
+            });
+        }
+        Ok(MeshGeometry {
+            mesh: std::sync::Arc::new(mesh),
+            scale,
+            tau,
+            regions,
+            horizon_ratio: m.horizon_ratio,
+        })
+    }
+
+    /// The `[[crack]]` entries.
+    fn cracks(
+        &self,
+        path: &Path,
+        dim: usize,
+        set_names: &[String],
+        geometry: &Geometry,
+        faces: &[FaceBc],
+    ) -> Result<Vec<Crack>> {
+        let mut out = Vec::new();
+        for (c, spec) in self.crack.iter().enumerate() {
+            let key = |k: &str| format!("crack[{c}].{k}");
+            let mu = spec.conductance.unwrap_or(0.0);
+            if !(0.0..1.0).contains(&mu) {
+                return Err(case_err(
+                    path,
+                    &key("conductance"),
+                    format!("must be in [0, 1), got {mu}"),
+                ));
+            }
+            let shape = match (&spec.group, &spec.points) {
+                (Some(g), None) => {
+                    if !matches!(geometry, Geometry::Mesh(_)) {
+                        return Err(case_err(
+                            path,
+                            &key("group"),
+                            "needs a [mesh]; a box case gives points",
+                        ));
+                    }
+                    let s = set_names.iter().position(|n| n == g).ok_or_else(|| {
+                        case_err(path, &key("group"), format!("`{g}` is not a physical group of dimension {}; the mesh has {set_names:?}", dim - 1))
+                    })?;
+                    if faces[s] != FaceBc::Free {
+                        return Err(case_err(
+                            path,
+                            &key("group"),
+                            format!("`{g}` also has a [boundary.{g}] condition"),
+                        ));
+                    }
+                    CrackShape::Set(s)
+                }
+                (None, Some(pts)) => {
+                    if dim != 2 {
+                        return Err(case_err(
+                            path,
+                            &key("points"),
+                            "polyline cracks are 2D; in 3D use a mesh group",
+                        ));
+                    }
+                    if pts.len() < 2 {
+                        return Err(case_err(path, &key("points"), "needs at least two points"));
+                    }
+                    let mut list = Vec::new();
+                    for (k, p) in pts.iter().enumerate() {
+                        let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
+                        list.push(Point::new(q[0], q[1], q[2]));
+                    }
+                    CrackShape::Polyline(list)
+                }
+                _ => {
+                    return Err(case_err(
+                        path,
+                        &format!("crack[{c}]"),
+                        "give either group or points",
+                    ))
+                }
+            };
+            out.push(Crack { shape, mu });
+        }
+        Ok(out)
+    }
+
+    fn validate(self, path: &Path) -> Result<Case> {
+        let err = |key: &str, m: String| case_err(path, key, m);
+        let dim = self.dimension;
+        if !(1..=3).contains(&dim) {
+            return Err(err("dimension", format!("must be 1, 2 or 3, got {dim}")));
+        }
+        let (section, thickness, area) = match (&self.domain, &self.mesh) {
+            (Some(d), None) => ("domain", d.thickness, d.area),
+            (None, Some(m)) => ("mesh", m.thickness, m.area),
+            (Some(_), Some(_)) => {
+                return Err(err(
+                    "mesh",
+                    "give [domain] (a built-in box) or [mesh] (a gmsh file), not both".into(),
+                ))
+            }
+            (None, None) => {
+                return Err(err(
+                    "domain",
+                    "missing: give [domain] with box regions, or [mesh] with a gmsh file".into(),
+                ))
+            }
+        };
+        let tau = match dim {
+            1 => {
+                if thickness.is_some() {
+                    return Err(err(
+                        &format!("{section}.thickness"),
+                        "is for 2D; a 1D bar takes area".into(),
+                    ));
+                }
+                positive(path, &format!("{section}.area"), area.unwrap_or(1.0))?
+            }
+            2 => {
+                if area.is_some() {
+                    return Err(err(
+                        &format!("{section}.area"),
+                        "is for 1D; a 2D body takes thickness".into(),
+                    ));
+                }
+                positive(
+                    path,
+                    &format!("{section}.thickness"),
+                    thickness.unwrap_or(1.0),
+                )?
+            }
+            _ => {
+                if area.is_some() || thickness.is_some() {
+                    return Err(err(
+                        section,
+                        "a 3D body takes neither area nor thickness".into(),
+                    ));
+                }
+                1.0
+            }
+        };
+        if self.material.is_empty() {
+            return Err(err(
+                "material",
+                "define at least one [material.<name>]".into(),
+            ));
+        }
+        let names: Vec<&String> = self.material.keys().collect();
+        let mut materials = Vec::new();
+        for (name, m) in &self.material {
+            positive(
+                path,
+                &format!("material.{name}.conductivity"),
+                m.conductivity,
+            )?;
+            positive(path, &format!("material.{name}.density"), m.density)?;
+            positive(
+                path,
+                &format!("material.{name}.specific_heat"),
+                m.specific_heat,
+            )?;
+            materials.push(*m);
+        }
+        if self.region.is_empty() {
+            return Err(err("region", "define at least one [[region]]".into()));
+        }
+        let mut per_region_initial = Vec::new();
+        let mut rules = Vec::new();
+        for (r, reg) in self.region.iter().enumerate() {
+            let key = |k: &str| format!("region[{r}].{k}");
             let horizon = match reg.horizon {
                 HorizonSpec::Factor(n) => {
                     HorizonRule::Factor(positive(path, &key("horizon.factor"), n)?)
@@ -516,15 +774,20 @@ impl CaseFile {
                 }
             };
             per_region_initial.push(reg.initial);
-            regions.push(BoxRegion {
-                name: reg.name.clone(),
-                min: rmin,
-                max: rmax,
-                cells,
-                horizon,
-                material: material as u16,
-            });
+            rules.push((horizon, material as u16));
         }
+        let geometry = match (&self.domain, &self.mesh) {
+            (Some(d), _) => Geometry::Box(self.box_geometry(path, d, tau, &rules)?),
+            (_, Some(m)) => Geometry::Mesh(self.mesh_geometry(path, m, tau, &rules)?),
+            (None, None) => unreachable!("checked above"),
+        };
+        let set_names: Vec<String> = match &geometry {
+            Geometry::Box(_) => FACE_NAMES[..2 * dim]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+            Geometry::Mesh(g) => g.set_names(),
+        };
         if self.kernel.p != 1 && self.kernel.p != 2 {
             return Err(err(
                 "kernel.p",
@@ -537,21 +800,25 @@ impl CaseFile {
             partial_volume: self.kernel.partial_volume,
             calibration: self.kernel.calibration,
         };
-        let mut faces = vec![FaceBc::Free; 6];
+        let mut faces = match &geometry {
+            Geometry::Box(_) => vec![FaceBc::Free; 6],
+            Geometry::Mesh(_) => vec![FaceBc::Free; set_names.len()],
+        };
         for (name, b) in &self.boundary {
             let key = |k: &str| format!("boundary.{name}.{k}");
-            let f = FACE_NAMES.iter().position(|n| n == name).ok_or_else(|| {
-                err(
-                    &format!("boundary.{name}"),
-                    format!("unknown face; use one of {:?}", &FACE_NAMES[..2 * dim]),
-                )
+            let f = set_names.iter().position(|n| n == name).ok_or_else(|| {
+                let what = match &geometry {
+                    Geometry::Box(_) if FACE_NAMES.contains(&name.as_str()) => {
+                        format!("a {dim}D case has faces {set_names:?}")
+                    }
+                    Geometry::Box(_) => format!("unknown face; use one of {set_names:?}"),
+                    Geometry::Mesh(_) => format!(
+                        "no physical group of dimension {} has this name; the mesh has {set_names:?}",
+                        dim - 1
+                    ),
+                };
+                err(&format!("boundary.{name}"), what)
             })?;
-            if f >= 2 * dim {
-                return Err(err(
-                    &format!("boundary.{name}"),
-                    format!("a {dim}D case has faces {:?}", &FACE_NAMES[..2 * dim]),
-                ));
-            }
             let value = |required: bool| -> Result<Option<Expr>> {
                 match &b.value {
                     Some(v) => Ok(Some(expr(v, path, &key("value"))?)),
@@ -697,21 +964,10 @@ impl CaseFile {
         }
         if let Some(r) = &self.reference {
             if let Some(p) = &r.probe {
-                coords(p, "reference.probe")?;
+                coords(path, dim, p, "reference.probe")?;
             }
         }
-        let geometry = BoxGeometry {
-            dim,
-            tau,
-            min: dmin,
-            max: dmax,
-            boundary_placement: self.domain.placement == Placement::Boundary,
-            regions,
-        };
-        geometry.validate().map_err(|e| match e {
-            Error::Model { key, message } => err(&key, message),
-            other => other,
-        })?;
+        let cracks = self.cracks(path, dim, &set_names, &geometry, &faces)?;
         Ok(Case {
             path: path.to_path_buf(),
             title: self.title,
@@ -721,6 +977,7 @@ impl CaseFile {
                 kernel,
                 bond_rule: self.kernel.bond_rule,
                 faces,
+                cracks,
                 source,
                 initial,
                 linear_consistency: self.kernel.linear_consistency,

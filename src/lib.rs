@@ -13,6 +13,7 @@ pub mod bc;
 pub mod case;
 pub mod cloud;
 pub mod consistency;
+pub mod crack;
 pub mod error;
 pub mod expr;
 pub mod gmsh;
@@ -27,5 +28,6 @@ pub mod output;
 pub mod report;
 pub mod run;
 pub mod solve;
+pub mod spatial;
 
 pub use error::{Error, Result};

@@ -1,12 +1,15 @@
 //! A ready-to-integrate model: cloud, bonds, conductance, capacities and boundary.
 
 use crate::bc::{Boundary, BoundaryInput, FaceBc};
-use crate::cloud::{BoxGeometry, Cloud};
+use crate::cloud::mesh::MeshGeometry;
+use crate::cloud::{BoxGeometry, Cloud, Sides};
 use crate::consistency::{correct, Correction};
+use crate::crack::{bond_factors, segments, triangles, Cutter};
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Kernel, PartialVolume};
 use crate::material::{BondRule, Material};
+use crate::math::Point;
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 
@@ -19,25 +22,104 @@ pub enum Initial {
     PerRegion(Vec<f64>),
 }
 
+/// Where the nodes come from.
+#[derive(Debug, Clone)]
+pub enum Geometry {
+    /// A box tiled by lattice regions.
+    Box(BoxGeometry),
+    /// A mesh: one node per element.
+    Mesh(MeshGeometry),
+}
+
+/// Where a pre-crack lies.
+#[derive(Debug, Clone)]
+pub enum CrackShape {
+    /// The facets of a mesh boundary set (a physical group embedded in the body).
+    Set(usize),
+    /// A polyline through these points (2D), m.
+    Polyline(Vec<Point>),
+}
+
+/// A pre-crack (formulation §5).
+#[derive(Debug, Clone)]
+pub struct Crack {
+    /// Its shape.
+    pub shape: CrackShape,
+    /// Conductance fraction μ kept by the bonds it cuts (0 = insulated).
+    pub mu: f64,
+}
+
 /// Everything that defines a model, independent of any file format.
 #[derive(Debug, Clone)]
 pub struct ModelSpec {
-    /// The built-in geometry.
-    pub geometry: BoxGeometry,
+    /// The geometry.
+    pub geometry: Geometry,
     /// Materials, indexed by the regions' material index.
     pub materials: Vec<Material>,
     /// Kernel.
     pub kernel: Kernel,
     /// Interface rule for bonds between materials.
     pub bond_rule: BondRule,
-    /// Conditions on the six faces (x_min … z_max).
+    /// Conditions by boundary set: the six faces x_min … z_max of a box, or a mesh's groups.
     pub faces: Vec<FaceBc>,
+    /// Pre-cracks.
+    pub cracks: Vec<Crack>,
     /// Volumetric heat source s(x, y, z, t), W/m³.
     pub source: Option<Expr>,
     /// Initial temperature.
     pub initial: Initial,
     /// Correct K so that linear fields are exact at horizon changes ([`crate::consistency`]).
     pub linear_consistency: bool,
+}
+
+/// Cutting facets of the cracks and, for a mesh, of the body's boundary.
+fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
+    let mut out = Vec::new();
+    for c in cracks {
+        match &c.shape {
+            CrackShape::Polyline(pts) => {
+                let pairs: Vec<[Point; 2]> = pts.windows(2).map(|w| [w[0], w[1]]).collect();
+                out.extend(segments(&pairs, c.mu));
+            }
+            CrackShape::Set(s) => {
+                let Sides::Mesh(m) = &cloud.sides else {
+                    continue;
+                };
+                let facets = &m.sets[*s].facets;
+                if cloud.dim == 2 {
+                    let pairs: Vec<[Point; 2]> = facets
+                        .iter()
+                        .map(|f| [f.corners[0], f.corners[1]])
+                        .collect();
+                    out.extend(segments(&pairs, c.mu));
+                } else {
+                    for f in facets {
+                        for t in triangles(&f.corners) {
+                            out.push(Cutter {
+                                corners: t,
+                                tips: [false; 2],
+                                mu: c.mu,
+                                boundary: None,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if let Sides::Mesh(m) = &cloud.sides {
+        for f in &m.boundary.facets {
+            for t in triangles(&f.corners) {
+                out.push(Cutter {
+                    corners: t,
+                    tips: [false; 2],
+                    mu: 0.0,
+                    boundary: Some(f.set),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// An assembled model.
@@ -80,46 +162,49 @@ impl Model {
                 }
             }
         }
-        let g = &spec.geometry;
-        let mut mask = 0u8;
-        for (f, bc) in spec.faces.iter().enumerate() {
-            if bc.needs_layer() {
-                mask |= 1 << f;
-            }
-        }
+        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
         let band = match spec.kernel.partial_volume {
             PartialVolume::AllOrNothing => 0.0,
             PartialVolume::Algorithm1 => 0.5,
         };
-        // one horizon plus the partial-volume band of the coarsest spacing
-        let max_spacing = g.regions.iter().map(|r| r.spacing()).fold(0.0, f64::max);
-        let max_horizon = g
-            .regions
-            .iter()
-            .map(|r| r.horizon.horizon(r.spacing()))
-            .fold(0.0, f64::max);
-        let layer = max_horizon + band * max_spacing;
-        let cloud = g.generate(mask, layer)?;
+        let cloud = match &spec.geometry {
+            Geometry::Box(g) => {
+                let mask = (0..6).filter(|&f| layered[f]).fold(0u8, |m, f| m | 1 << f);
+                // one horizon plus the partial-volume band of the coarsest spacing
+                let max_spacing = g.regions.iter().map(|r| r.spacing()).fold(0.0, f64::max);
+                let max_horizon = g
+                    .regions
+                    .iter()
+                    .map(|r| r.horizon.horizon(r.spacing()))
+                    .fold(0.0, f64::max);
+                g.generate(mask, max_horizon + band * max_spacing)?
+            }
+            Geometry::Mesh(g) => g.generate(&layered, band)?,
+        };
         let mat = |i: usize| spec.materials[cloud.material[i] as usize];
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
         let horizons = Horizons::build(&cloud, &spec.kernel);
-        let weights = directed_weights(
+        let mut weights = directed_weights(
             &cloud,
             &horizons,
             &spec.kernel,
             &conductivity,
             spec.bond_rule,
         );
+        let cutters = cutters(&cloud, &spec.cracks);
+        let mu = bond_factors(&cloud, &horizons, &cutters);
+        for (w, m) in weights.iter_mut().zip(&mu) {
+            *w *= m;
+        }
         let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
         let correction = if spec.linear_consistency {
-            // nodes whose bonds reach no face without a fictitious layer
+            // nodes whose bonds reach no boundary without a fictitious layer and cross no crack
+            let free = cloud.distances_to_free(&layered);
             let sel: Vec<bool> = (0..cloud.n_body)
                 .map(|i| {
-                    let reach = cloud.horizon[i] + cloud.spacing[i];
-                    (0..2 * cloud.dim)
-                        .filter(|&f| !spec.faces[f].needs_layer())
-                        .all(|f| cloud.distance_to_face(&cloud.pos[i], f) > reach)
+                    free[i] > cloud.horizon[i] + cloud.spacing[i]
+                        && horizons.row(i).all(|b| mu[b] == 1.0)
                 })
                 .collect();
             let c = correct(&mut conductance, &cloud, &sel, 1e-12, 20_000);

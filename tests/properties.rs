@@ -148,9 +148,12 @@ type = "insulated"
 fn mirror_layers_keep_a_linear_field_steady_everywhere() {
     let case = dual_horizon_case(MIRROR_FACES, "lattice");
     let mut spec = case.spec.clone();
-    spec.geometry.regions.truncate(1);
-    spec.geometry.regions[0].max[0] = 2.0;
-    spec.geometry.regions[0].cells[0] = 80;
+    let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
+        panic!("a box case")
+    };
+    g.regions.truncate(1);
+    g.regions[0].max[0] = 2.0;
+    g.regions[0].cells[0] = 80;
     spec.initial =
         peritherm::model::Initial::Field(peritherm::expr::Expr::parse("1 + 3*x").unwrap());
     let model = Model::build(&spec).unwrap();
@@ -348,7 +351,10 @@ end = 1.0
 #[test]
 fn linear_consistency_refuses_negative_conductances() {
     let mut spec = dual_horizon_case(MIRROR_FACES, "lattice").spec;
-    spec.geometry.regions[0].horizon = peritherm::cloud::HorizonRule::Factor(1.5);
+    let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
+        panic!("a box case")
+    };
+    g.regions[0].horizon = peritherm::cloud::HorizonRule::Factor(1.5);
     spec.linear_consistency = true;
     let err = Model::build(&spec).unwrap_err().to_string();
     assert!(

@@ -4,8 +4,13 @@
 //! nodes after them (seed 004 fictitious regions, seed 001 mirror/naive layers). Every
 //! node has its own spacing Δ and horizon δ, which is what dual horizon needs (seed 004 §3).
 
+pub mod facets;
+pub mod mesh;
+pub mod order;
+
 use crate::error::{Error, Result};
-use crate::math::Point;
+use crate::math::{NodeId, Point, Vector};
+use facets::FacetSet;
 
 /// Faces of an axis-aligned box, in the order x_min, x_max, y_min, y_max, z_min, z_max.
 pub const FACE_NAMES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"];
@@ -20,6 +25,55 @@ pub fn inward(face: Face) -> f64 {
     } else {
         -1.0
     }
+}
+
+/// One reflection of a mirrored fictitious node: across which set, where, and how far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reflection {
+    /// Boundary set crossed.
+    pub set: usize,
+    /// Foot of the reflection on the set (where boundary values are evaluated), m.
+    pub foot: Point,
+    /// Distance between the point and its mirror image, m.
+    pub distance: f64,
+}
+
+/// Where a fictitious node takes its temperature from (formulation §3).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Fictitious {
+    /// A lattice node of a box geometry, outside the faces in the bit mask (bit f = face f).
+    Lattice {
+        /// Faces the node lies outside of.
+        outside: u8,
+    },
+    /// The image of body node `of` through `chain` (outermost reflection first).
+    Mirror {
+        /// The body node mirrored.
+        of: NodeId,
+        /// Reflections from the fictitious node back to `of`.
+        chain: Vec<Reflection>,
+    },
+}
+
+/// Boundary sets of a mesh-based cloud.
+#[derive(Debug, Clone)]
+pub struct MeshSides {
+    /// Set names (physical groups one dimension below the body).
+    pub names: Vec<String>,
+    /// Facets of each set.
+    pub sets: Vec<FacetSet>,
+    /// Every boundary facet of the body (by topology), with the set it belongs to.
+    pub boundary: FacetSet,
+}
+
+/// The body's boundary: the faces of a box, or facet sets of a mesh.
+#[derive(Debug, Clone, Default)]
+pub enum Sides {
+    /// Sets 0..2d are the box faces x_min … z_max.
+    #[default]
+    Box,
+    /// Sets are physical groups of a mesh.
+    Mesh(Box<MeshSides>),
 }
 
 /// Struct-of-arrays node cloud.
@@ -43,8 +97,10 @@ pub struct Cloud {
     pub region: Vec<u16>,
     /// Number of body nodes; nodes `n_body..` are fictitious.
     pub n_body: usize,
-    /// For each fictitious node (index − n_body), the bit mask of faces it lies outside of.
-    pub outside: Vec<u8>,
+    /// For each fictitious node (index − n_body), where its temperature comes from.
+    pub fictitious: Vec<Fictitious>,
+    /// Boundary sets.
+    pub sides: Sides,
     /// Bounding box of the body: min corner, m.
     pub min: Point,
     /// Bounding box of the body: max corner, m.
@@ -103,6 +159,105 @@ impl Cloud {
     /// Total body volume, m³.
     pub fn body_volume(&self) -> f64 {
         self.volume[..self.n_body].iter().sum()
+    }
+
+    /// Number of boundary sets (box faces, or mesh groups one dimension below the body).
+    pub fn n_sets(&self) -> usize {
+        match &self.sides {
+            Sides::Box => 2 * self.dim,
+            Sides::Mesh(m) => m.sets.len(),
+        }
+    }
+
+    /// Distance from `p` to boundary set `s`, m (∞ for an empty set).
+    pub fn set_distance(&self, p: &Point, s: usize) -> f64 {
+        match &self.sides {
+            Sides::Box => self.distance_to_face(p, s),
+            Sides::Mesh(m) => m.sets[s].nearest(p).map_or(f64::INFINITY, |(_, d)| d),
+        }
+    }
+
+    /// Nearest point of set `s` to `p` and the unit normal there pointing into the body.
+    pub fn set_foot(&self, p: &Point, s: usize) -> (Point, Vector) {
+        match &self.sides {
+            Sides::Box => {
+                let mut q = *p;
+                q[s / 2] = self.face_plane(s);
+                let mut n = Vector::zeros();
+                n[s / 2] = inward(s);
+                (q, n)
+            }
+            Sides::Mesh(m) => match m.sets[s].nearest(p) {
+                Some((k, _)) => {
+                    let f = &m.sets[s].facets[k];
+                    (f.closest(p), -f.normal)
+                }
+                None => (*p, Vector::zeros()),
+            },
+        }
+    }
+
+    /// Body nodes in the first `layers` node layers next to set `s`: closer than
+    /// (layers − ¼)·Δ_i, and on a mesh also every element with a side on the set.
+    pub fn set_layer(&self, s: usize, layers: f64) -> Vec<usize> {
+        match &self.sides {
+            Sides::Box => self.face_layer(s, layers),
+            Sides::Mesh(m) => {
+                let mut hit = vec![false; self.n_body];
+                for f in &m.sets[s].facets {
+                    hit[f.cell as usize] = true;
+                }
+                (0..self.n_body)
+                    .filter(|&i| {
+                        hit[i]
+                            || self.set_distance(&self.pos[i], s)
+                                < (layers - 0.25) * self.spacing[i]
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Body nodes exposed on set `s` with their exposed area, m².
+    pub fn exposed(&self, s: usize) -> Vec<(usize, f64)> {
+        match &self.sides {
+            Sides::Box => self
+                .face_layer(s, 1.0)
+                .into_iter()
+                .map(|i| (i, self.exposed_area(i)))
+                .collect(),
+            Sides::Mesh(m) => {
+                let mut area: std::collections::BTreeMap<usize, f64> = Default::default();
+                for f in &m.sets[s].facets {
+                    *area.entry(f.cell as usize).or_default() += f.area;
+                }
+                area.into_iter().collect()
+            }
+        }
+    }
+
+    /// Distance of every body node to the nearest boundary without a fictitious layer, m
+    /// (`layered[s]` tells which sets have one).
+    pub fn distances_to_free(&self, layered: &[bool]) -> Vec<f64> {
+        let has = |s: usize| layered.get(s).copied().unwrap_or(false);
+        match &self.sides {
+            Sides::Box => (0..self.n_body)
+                .map(|i| {
+                    (0..2 * self.dim)
+                        .filter(|&f| !has(f))
+                        .map(|f| self.distance_to_face(&self.pos[i], f))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect(),
+            Sides::Mesh(m) => {
+                let free = m
+                    .boundary
+                    .filter(|f| !f.set.is_some_and(|s| has(s as usize)));
+                (0..self.n_body)
+                    .map(|i| free.nearest(&self.pos[i]).map_or(f64::INFINITY, |(_, d)| d))
+                    .collect()
+            }
+        }
     }
 
     fn push(&mut self, p: Point, v: f64, dx: f64, delta: f64, mat: u16, reg: u16) {
@@ -336,7 +491,7 @@ impl BoxGeometry {
         c.n_body = c.len();
         for (p, v, h, d, m, r, out) in fict {
             c.push(p, v, h, d, m, r);
-            c.outside.push(out);
+            c.fictitious.push(Fictitious::Lattice { outside: out });
         }
         Ok(c)
     }
@@ -417,7 +572,7 @@ mod tests {
         let c = plate(false, 0.5).generate(0b0001, 0.16).unwrap();
         for f in 0..c.n_fictitious() {
             let p = c.pos[c.n_body + f];
-            assert_eq!(c.outside[f], 1);
+            assert_eq!(c.fictitious[f], Fictitious::Lattice { outside: 1 });
             assert!(p.x < -0.5 && p.x > -0.5 - 0.16 - 0.05);
         }
         // 4 columns of 20 nodes (0.16 / 0.05 rounded up)

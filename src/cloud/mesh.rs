@@ -1,0 +1,485 @@
+//! Node clouds from meshes: one node per element at its centroid, with the element's measure
+//! as volume and its characteristic size as spacing; boundary sets from physical groups and
+//! fictitious layers made by mirroring body nodes across the nearest boundary facet.
+
+use super::facets::{Facet, FacetSet};
+use super::order::morton_order;
+use super::{Cloud, Fictitious, HorizonRule, MeshSides, Reflection, Sides};
+use crate::error::{Error, Result};
+use crate::math::{NodeId, Point, Vector};
+use crate::mesh::{measure_and_centroid, Element, ElementKind, Mesh};
+use crate::spatial::PointIndex;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+use std::sync::Arc;
+
+/// A region of a mesh geometry: a physical group of the body's dimension.
+#[derive(Debug, Clone)]
+pub struct MeshRegion {
+    /// The group's name.
+    pub name: String,
+    /// Index of the group in [`Mesh::groups`].
+    pub group: usize,
+    /// Horizon rule (δ = n·Δ_i or an explicit δ).
+    pub horizon: HorizonRule,
+    /// Material index.
+    pub material: u16,
+}
+
+/// A geometry given by a mesh.
+#[derive(Debug, Clone)]
+pub struct MeshGeometry {
+    /// The mesh, in file units.
+    pub mesh: Arc<Mesh>,
+    /// Metres per file unit.
+    pub scale: f64,
+    /// Out-of-plane measure τ (see [`Cloud::tau`]).
+    pub tau: f64,
+    /// Regions: every element of the body's dimension belongs to one of them.
+    pub regions: Vec<MeshRegion>,
+    /// Largest ratio of horizons between nearby nodes; larger horizons are reduced to it.
+    pub horizon_ratio: Option<f64>,
+}
+
+/// Corner indices of each face of an element (gmsh node ordering).
+fn faces_of(kind: ElementKind) -> &'static [&'static [usize]] {
+    match kind {
+        ElementKind::Point => &[],
+        ElementKind::Line => &[&[0], &[1]],
+        ElementKind::Triangle => &[&[0, 1], &[1, 2], &[2, 0]],
+        ElementKind::Quad => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
+        ElementKind::Tet => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]],
+        ElementKind::Hex => &[
+            &[0, 3, 2, 1],
+            &[0, 1, 5, 4],
+            &[0, 4, 7, 3],
+            &[1, 2, 6, 5],
+            &[2, 3, 7, 6],
+            &[4, 5, 6, 7],
+        ],
+    }
+}
+
+type FaceKey = [u32; 4];
+
+fn key_of(nodes: &[u32]) -> FaceKey {
+    let mut k = [u32::MAX; 4];
+    k[..nodes.len()].copy_from_slice(nodes);
+    k.sort_unstable();
+    k
+}
+
+fn facet_kind(n: usize) -> ElementKind {
+    match n {
+        1 => ElementKind::Point,
+        2 => ElementKind::Line,
+        3 => ElementKind::Triangle,
+        _ => ElementKind::Quad,
+    }
+}
+
+impl MeshGeometry {
+    /// Dimension of the body.
+    pub fn dim(&self) -> usize {
+        self.mesh.dim()
+    }
+
+    /// Mesh group indices of the boundary sets (groups one dimension below the body), in order.
+    pub fn set_groups(&self) -> Vec<usize> {
+        let d = self.dim();
+        (0..self.mesh.groups.len())
+            .filter(|&g| d > 0 && self.mesh.groups[g].dim == d - 1)
+            .collect()
+    }
+
+    /// Names of the boundary sets, by set index.
+    pub fn set_names(&self) -> Vec<String> {
+        self.set_groups()
+            .iter()
+            .map(|&g| self.mesh.groups[g].name.clone())
+            .collect()
+    }
+
+    fn region_of(&self, e: &Element) -> Result<usize> {
+        e.groups
+            .iter()
+            .find_map(|&g| self.regions.iter().position(|r| r.group == g as usize))
+            .ok_or_else(|| {
+                let name = e
+                    .groups
+                    .first()
+                    .map(|&g| self.mesh.groups[g as usize].name.clone())
+                    .unwrap_or_default();
+                Error::model(
+                    "region",
+                    format!("physical group `{name}` has elements but no [[region]]: add one named `{name}`"),
+                )
+            })
+    }
+
+    /// Builds the cloud; sets with `layered[s]` get a mirrored fictitious layer as thick as
+    /// the horizons next to them (plus `band` spacings for partial volumes).
+    pub fn generate(&self, layered: &[bool], band: f64) -> Result<Cloud> {
+        let mesh = &*self.mesh;
+        let dim = self.dim();
+        if !(1..=3).contains(&dim) {
+            return Err(Error::model(
+                "mesh",
+                "has no line, surface or volume elements",
+            ));
+        }
+        let s = self.scale;
+        let cells: Vec<&Element> = mesh
+            .elements
+            .iter()
+            .filter(|e| e.kind.dim() == dim)
+            .collect();
+        let extent = mesh
+            .nodes
+            .iter()
+            .map(|p| p.coords.amax())
+            .fold(0.0, f64::max);
+        for e in &cells {
+            for &n in &e.nodes {
+                let p = mesh.nodes[n as usize];
+                if (dim < 3 && p.z.abs() > 1e-9 * extent) || (dim < 2 && p.y.abs() > 1e-9 * extent)
+                {
+                    return Err(Error::model(
+                        "mesh",
+                        format!(
+                            "a {dim}D mesh must lie in the {} (node at {}, {}, {})",
+                            if dim == 2 { "z = 0 plane" } else { "x axis" },
+                            p.x,
+                            p.y,
+                            p.z
+                        ),
+                    ));
+                }
+            }
+        }
+        // body nodes at centroids, in Morton order
+        let mut raw = Vec::with_capacity(cells.len());
+        for e in &cells {
+            let (m, c) = measure_and_centroid(e.kind, &mesh.corners(e));
+            if m.is_nan() || m <= 0.0 {
+                return Err(Error::model(
+                    "mesh",
+                    format!(
+                        "an element has zero measure near ({}, {}, {})",
+                        c.x, c.y, c.z
+                    ),
+                ));
+            }
+            raw.push((
+                m * s.powi(dim as i32),
+                Point::from(c.coords * s),
+                self.region_of(e)?,
+            ));
+        }
+        let perm = morton_order(&raw.iter().map(|r| r.1).collect::<Vec<_>>());
+        let mut new_of = vec![0u32; cells.len()];
+        for (new, &old) in perm.iter().enumerate() {
+            new_of[old] = new as u32;
+        }
+        let mut c = Cloud {
+            dim,
+            tau: self.tau,
+            ..Default::default()
+        };
+        for &old in &perm {
+            let (m, p, r) = raw[old];
+            let reg = &self.regions[r];
+            let dx = m.powf(1.0 / dim as f64);
+            c.push(
+                p,
+                m * self.tau,
+                dx,
+                reg.horizon.horizon(dx),
+                reg.material,
+                r as u16,
+            );
+        }
+        c.n_body = c.len();
+        c.min = c.pos[0];
+        c.max = c.pos[0];
+        for p in &c.pos {
+            for a in 0..3 {
+                c.min[a] = c.min[a].min(p[a]);
+                c.max[a] = c.max[a].max(p[a]);
+            }
+        }
+        let index = PointIndex::new(&c.pos);
+        if let Some(ratio) = self.horizon_ratio {
+            grade_horizons(&mut c, &index, ratio);
+        }
+        let sides = self.sides(&cells, &new_of)?;
+        let body: Vec<&Element> = perm.iter().map(|&old| cells[old]).collect();
+        let locate = Locator {
+            mesh,
+            scale: s,
+            cells: &body,
+            index: &index,
+        };
+        mirror_layers(&mut c, &sides, &locate, layered, band);
+        c.sides = Sides::Mesh(Box::new(sides));
+        Ok(c)
+    }
+
+    /// Boundary facets (by topology) and the facets of every set, in metres.
+    fn sides(&self, cells: &[&Element], new_of: &[u32]) -> Result<MeshSides> {
+        let mesh = &*self.mesh;
+        let dim = self.dim();
+        let s = self.scale;
+        let mut faces: HashMap<FaceKey, (u32, Vec<u32>, u8)> = HashMap::new();
+        for (k, e) in cells.iter().enumerate() {
+            for f in faces_of(e.kind) {
+                let nodes: Vec<u32> = f.iter().map(|&i| e.nodes[i]).collect();
+                faces
+                    .entry(key_of(&nodes))
+                    .and_modify(|v| v.2 += 1)
+                    .or_insert((new_of[k], nodes, 1));
+            }
+        }
+        let mut cell_centre = vec![Point::origin(); cells.len()];
+        for (k, e) in cells.iter().enumerate() {
+            cell_centre[new_of[k] as usize] = measure_and_centroid(e.kind, &mesh.corners(e)).1;
+        }
+        let make = |nodes: &[u32], cell: u32, set: Option<u16>| -> Facet {
+            let q: Vec<Point> = nodes.iter().map(|&n| mesh.nodes[n as usize]).collect();
+            let inside = cell_centre[cell as usize];
+            let mut n = match q.len() {
+                1 => Vector::x(),
+                2 => {
+                    let t = q[1] - q[0];
+                    Vector::new(t.y, -t.x, 0.0)
+                }
+                3 => (q[1] - q[0]).cross(&(q[2] - q[0])),
+                _ => (q[2] - q[0]).cross(&(q[3] - q[1])),
+            }
+            .normalize();
+            if (inside - q[0]).dot(&n) > 0.0 {
+                n = -n;
+            }
+            let (m, _) = measure_and_centroid(facet_kind(q.len()), &q);
+            let tau_area = match dim {
+                1 => self.tau,
+                2 => m * s * self.tau,
+                _ => m * s * s,
+            };
+            Facet {
+                corners: q.iter().map(|p| Point::from(p.coords * s)).collect(),
+                normal: n,
+                area: tau_area,
+                cell,
+                set,
+            }
+        };
+        let groups = self.set_groups();
+        let mut owner: HashMap<FaceKey, u16> = HashMap::new();
+        let mut sets = Vec::with_capacity(groups.len());
+        for (si, &g) in groups.iter().enumerate() {
+            let mut list = Vec::new();
+            for e in mesh
+                .elements
+                .iter()
+                .filter(|e| e.groups.contains(&(g as u16)))
+            {
+                let key = key_of(&e.nodes);
+                let Some((cell, _, _)) = faces.get(&key) else {
+                    return Err(Error::model(
+                        format!("mesh group {}", mesh.groups[g].name),
+                        "has an element that is not a side of any body element: re-mesh with the curve (surface) embedded in the body",
+                    ));
+                };
+                owner.entry(key).or_insert(si as u16);
+                list.push(make(&e.nodes, *cell, Some(si as u16)));
+            }
+            sets.push(FacetSet::new(list));
+        }
+        let boundary: Vec<Facet> = faces
+            .iter()
+            .filter(|(_, v)| v.2 == 1)
+            .map(|(k, (cell, nodes, _))| make(nodes, *cell, owner.get(k).copied()))
+            .collect();
+        // a deterministic order, whatever the hash map's
+        let mut boundary = boundary;
+        boundary.sort_by(|a, b| {
+            a.cell
+                .cmp(&b.cell)
+                .then(a.centre().coords.x.total_cmp(&b.centre().coords.x))
+                .then(a.centre().coords.y.total_cmp(&b.centre().coords.y))
+                .then(a.centre().coords.z.total_cmp(&b.centre().coords.z))
+        });
+        Ok(MeshSides {
+            names: self.set_names(),
+            sets,
+            boundary: FacetSet::new(boundary),
+        })
+    }
+}
+
+/// Finds whether a point lies in the body, from the cells next to it.
+struct Locator<'a> {
+    mesh: &'a Mesh,
+    scale: f64,
+    cells: &'a [&'a Element],
+    index: &'a PointIndex,
+}
+
+impl Locator<'_> {
+    /// True when `p` (m) lies inside or on one of the body elements nearest to it.
+    fn inside(&self, p: &Point) -> bool {
+        let q = Point::from(p.coords / self.scale);
+        self.index.nearest(p, 12).into_iter().any(|(k, _)| {
+            let e = self.cells[k];
+            element_contains(e.kind, &self.mesh.corners(e), &q)
+        })
+    }
+}
+
+/// Mirrors body nodes across the nearest facet of each layered set, then mirrors those
+/// images across a second layered set near corners; images inside the body are dropped.
+fn mirror_layers(c: &mut Cloud, sides: &MeshSides, locate: &Locator, layered: &[bool], band: f64) {
+    let nb = c.n_body;
+    let reach = |i: usize| 1.25 * (c.horizon[i] + band * c.spacing[i]);
+    let is_layered = |s: usize| layered.get(s).copied().unwrap_or(false);
+    let mut ghosts: Vec<(usize, Point, Vec<Reflection>)> = Vec::new();
+    for (si, set) in sides.sets.iter().enumerate() {
+        if !is_layered(si) {
+            continue;
+        }
+        for i in 0..nb {
+            let p = c.pos[i];
+            let Some((k, d)) = set.nearest(&p) else {
+                continue;
+            };
+            if d > reach(i) {
+                continue;
+            }
+            let f = &set.facets[k];
+            let q = f.reflect(&p);
+            if f.outward_distance(&q) <= 0.0 || locate.inside(&q) {
+                continue;
+            }
+            let first = Reflection {
+                set: si,
+                foot: f.closest(&p),
+                distance: (q - p).norm(),
+            };
+            // a second reflection fills the quadrant beyond a corner with a later set
+            for (sj, other) in sides.sets.iter().enumerate().skip(si + 1) {
+                if !is_layered(sj) {
+                    continue;
+                }
+                let Some((k2, _)) = other.nearest(&q) else {
+                    continue;
+                };
+                let f2 = &other.facets[k2];
+                let d2 = -f2.outward_distance(&q);
+                if d2 <= 0.0 || d2 > reach(i) {
+                    continue;
+                }
+                let q2 = f2.reflect(&q);
+                if locate.inside(&q2) {
+                    continue;
+                }
+                let second = Reflection {
+                    set: sj,
+                    foot: f2.closest(&q),
+                    distance: (q2 - q).norm(),
+                };
+                ghosts.push((i, q2, vec![second, first.clone()]));
+            }
+            ghosts.push((i, q, vec![first]));
+        }
+    }
+    for (i, q, chain) in ghosts {
+        let (v, dx, d) = (c.volume[i], c.spacing[i], c.horizon[i]);
+        let (m, r) = (c.material[i], c.region[i]);
+        c.push(q, v, dx, d, m, r);
+        c.fictitious.push(Fictitious::Mirror {
+            of: i as NodeId,
+            chain,
+        });
+    }
+}
+
+/// True when `p` lies in the element with corners `c` (boundary included, round-off tolerant).
+fn element_contains(kind: ElementKind, c: &[Point], p: &Point) -> bool {
+    let eps = 1e-12;
+    let tri = |a: &Point, b: &Point, d: &Point| -> bool {
+        let area = (b - a).cross(&(d - a)).z;
+        let s = area.signum();
+        let w = [
+            (b - p).cross(&(d - p)).z * s,
+            (d - p).cross(&(a - p)).z * s,
+            (a - p).cross(&(b - p)).z * s,
+        ];
+        w.iter().all(|&x| x >= -eps * area.abs())
+    };
+    let tet = |a: &Point, b: &Point, d: &Point, e: &Point| -> bool {
+        let vol =
+            |w: &Point, x: &Point, y: &Point, z: &Point| (x - w).cross(&(y - w)).dot(&(z - w));
+        let v = vol(a, b, d, e);
+        let s = v.signum();
+        [
+            vol(p, b, d, e),
+            vol(a, p, d, e),
+            vol(a, b, p, e),
+            vol(a, b, d, p),
+        ]
+        .iter()
+        .all(|&x| x * s >= -eps * v.abs())
+    };
+    match kind {
+        ElementKind::Point => false,
+        ElementKind::Line => {
+            let (lo, hi) = (c[0].x.min(c[1].x), c[0].x.max(c[1].x));
+            p.x >= lo && p.x <= hi
+        }
+        ElementKind::Triangle => tri(&c[0], &c[1], &c[2]),
+        ElementKind::Quad => tri(&c[0], &c[1], &c[2]) || tri(&c[0], &c[2], &c[3]),
+        ElementKind::Tet => tet(&c[0], &c[1], &c[2], &c[3]),
+        ElementKind::Hex => [
+            [0, 1, 2, 6],
+            [0, 2, 3, 6],
+            [0, 3, 7, 6],
+            [0, 7, 4, 6],
+            [0, 4, 5, 6],
+            [0, 5, 1, 6],
+        ]
+        .iter()
+        .any(|t| tet(&c[t[0]], &c[t[1]], &c[t[2]], &c[t[3]])),
+    }
+}
+
+/// Limits horizons so that no node's δ exceeds `ratio` times a nearby node's (Dijkstra order).
+fn grade_horizons(c: &mut Cloud, index: &PointIndex, ratio: f64) {
+    let nb = c.n_body;
+    let k = 3usize.pow(c.dim as u32);
+    let nbrs: Vec<Vec<usize>> = (0..nb)
+        .map(|i| {
+            index
+                .nearest(&c.pos[i], k)
+                .into_iter()
+                .map(|(j, _)| j)
+                .collect()
+        })
+        .collect();
+    let mut heap: BinaryHeap<Reverse<(u64, usize)>> = (0..nb)
+        .map(|i| Reverse((c.horizon[i].to_bits(), i)))
+        .collect();
+    while let Some(Reverse((bits, i))) = heap.pop() {
+        let d = f64::from_bits(bits);
+        if d > c.horizon[i] {
+            continue;
+        }
+        for &j in &nbrs[i] {
+            let cap = ratio * d;
+            if cap < c.horizon[j] {
+                c.horizon[j] = cap;
+                heap.push(Reverse((cap.to_bits(), j)));
+            }
+        }
+    }
+}
