@@ -83,6 +83,18 @@ pub enum Reference {
         /// Initial θ, °C.
         initial: f64,
     },
+    /// Steady conduction in a ring about the origin with both circles held:
+    /// θ = θ_i + (θ_o − θ_i) ln(r/r_i)/ln(r_o/r_i) (independent of t).
+    AnnulusSteady {
+        /// Inner radius r_i, m.
+        inner_radius: f64,
+        /// Outer radius r_o, m.
+        outer_radius: f64,
+        /// θ on the inner circle, °C.
+        inner: f64,
+        /// θ on the outer circle, °C.
+        outer: f64,
+    },
 }
 
 /// Number of series terms so that e^(−α λ_n² t) < e^(−40) beyond, with λ_n = c n.
@@ -110,7 +122,10 @@ fn slab(s: f64, l: f64, alpha: f64, t: f64) -> f64 {
 impl Reference {
     /// True when the solution varies with y as well as x.
     pub fn depends_on_y(&self) -> bool {
-        matches!(self, Reference::SquareFixedEdges { .. })
+        matches!(
+            self,
+            Reference::SquareFixedEdges { .. } | Reference::AnnulusSteady { .. }
+        )
     }
 
     /// The classical temperature at every point, evaluating each distinct (x, y) once
@@ -145,6 +160,15 @@ impl Reference {
     /// The classical temperature at a point and time, °C.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
         match *self {
+            Reference::AnnulusSteady {
+                inner_radius: ri,
+                outer_radius: ro,
+                inner,
+                outer,
+            } => {
+                let r = x.hypot(y);
+                inner + (outer - inner) * (r / ri).ln() / (ro / ri).ln()
+            }
             Reference::BarFixedEnds {
                 x0,
                 length: l,

@@ -4,8 +4,10 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use peritherm::case::Case;
-use peritherm::model::Model;
+use peritherm::model::{crack_cutters, Model};
+use peritherm::output::read_field;
 use peritherm::output::RunSummary;
+use peritherm::report::field_difference;
 use peritherm::run::run_case;
 use peritherm::solve::explicit::choose_dt;
 use std::io::IsTerminal;
@@ -44,6 +46,14 @@ enum Command {
         /// Output directories of `peritherm run`.
         #[arg(required = true)]
         runs: Vec<PathBuf>,
+    },
+    /// Compare the fields of a run with those of a reference run of the same body (e.g. a
+    /// refined mesh against a uniform fine one), output time by output time.
+    Compare {
+        /// Output directory of the run to judge.
+        run: PathBuf,
+        /// Output directory of the reference run.
+        reference: PathBuf,
     },
     /// Validate a case and print its size and stable time step without running it.
     Check {
@@ -116,6 +126,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Compare { run, reference } => compare(&run, &reference),
         Command::Check { case } => {
             let case = Case::load(&case)?;
             let model =
@@ -136,4 +147,37 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
     }
+}
+
+/// `peritherm compare`: max and mean |Δθ| per output time, the reference interpolated at the
+/// run's nodes without looking across the run's cracks.
+fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result<()> {
+    let a = RunSummary::read(run)?;
+    let b = RunSummary::read(reference)?;
+    let case = Case::load(std::path::Path::new(&a.case))?;
+    let cloud = case
+        .spec
+        .geometry
+        .bare_cloud()
+        .with_context(|| case.path.display().to_string())?;
+    let cracks = crack_cutters(&cloud, &case.spec.cracks);
+    println!("| t (s) | max abs diff (°C) | mean abs diff (°C) | where (m) |");
+    println!("|---|---|---|---|");
+    for (k, t) in a.output_times.iter().enumerate() {
+        let Some(kb) = b
+            .output_times
+            .iter()
+            .position(|tb| (tb - t).abs() <= 1e-9 * t.abs())
+        else {
+            anyhow::bail!("{}: has no output at t = {t} s", reference.display());
+        };
+        let fa = read_field(&run.join(&a.fields[k]))?;
+        let fb = read_field(&reference.join(&b.fields[kb]))?;
+        let d = field_difference(cloud.dim, (&fa.0, &fa.1), (&fb.0, &fb.1), &cracks);
+        println!(
+            "| {t} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",
+            d.max_abs, d.mean_abs, d.at.x, d.at.y, d.at.z
+        );
+    }
+    Ok(())
 }

@@ -75,7 +75,7 @@ pub struct Mesh {
     pub nodes: Vec<Point>,
     /// Elements of every dimension that belong to at least one physical group.
     pub elements: Vec<Element>,
-    /// Physical groups, in the file's order.
+    /// Physical groups, in ascending (dimension, tag) order.
     pub groups: Vec<Group>,
 }
 

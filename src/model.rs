@@ -31,6 +31,16 @@ pub enum Geometry {
     Mesh(MeshGeometry),
 }
 
+impl Geometry {
+    /// The body nodes and boundary sets alone (no fictitious layer), for post-processing.
+    pub fn bare_cloud(&self) -> Result<Cloud> {
+        match self {
+            Geometry::Box(g) => g.generate(0, 0.0),
+            Geometry::Mesh(g) => g.generate(&[], 0.0),
+        }
+    }
+}
+
 /// Where a pre-crack lies.
 #[derive(Debug, Clone)]
 pub enum CrackShape {
@@ -72,8 +82,8 @@ pub struct ModelSpec {
     pub linear_consistency: bool,
 }
 
-/// Cutting facets of the cracks and, for a mesh, of the body's boundary.
-fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
+/// Cutting facets of the cracks (formulation §5).
+pub fn crack_cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
     let mut out = Vec::new();
     for c in cracks {
         match &c.shape {
@@ -107,6 +117,12 @@ fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
             }
         }
     }
+    out
+}
+
+/// Cutting facets of the cracks and, for a mesh, of the body's boundary.
+fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
+    let mut out = crack_cutters(cloud, cracks);
     if let Sides::Mesh(m) = &cloud.sides {
         for f in &m.boundary.facets {
             for t in triangles(&f.corners) {

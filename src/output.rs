@@ -5,6 +5,7 @@
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
+use crate::math::Point;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -41,6 +42,42 @@ pub fn field_csv(cloud: &Cloud, theta: &[f64]) -> String {
         );
     }
     s
+}
+
+/// Reads the positions and temperatures of a `field_<k>.csv`.
+pub fn read_field(path: &Path) -> Result<(Vec<Point>, Vec<f64>)> {
+    let bad = |m: String| Error::Io {
+        path: path.to_path_buf(),
+        error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+    };
+    let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let mut lines = text.lines();
+    if !lines
+        .next()
+        .is_some_and(|h| h.starts_with("x,y,z,temperature"))
+    {
+        return Err(bad(
+            "not a peritherm field file (header x,y,z,temperature,...)".into(),
+        ));
+    }
+    let (mut pos, mut theta) = (Vec::new(), Vec::new());
+    for (k, line) in lines.enumerate() {
+        let v: Vec<f64> = line
+            .split(',')
+            .take(4)
+            .map(str::parse)
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| bad(format!("line {}: {e}", k + 2)))?;
+        if v.len() < 4 {
+            return Err(bad(format!("line {}: fewer than 4 columns", k + 2)));
+        }
+        pos.push(Point::new(v[0], v[1], v[2]));
+        theta.push(v[3]);
+    }
+    Ok((pos, theta))
 }
 
 /// Comparison with a classical solution at one output time (formulation §9).

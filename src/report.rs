@@ -2,8 +2,11 @@
 
 use crate::case::ReferenceSpec;
 use crate::cloud::Cloud;
+use crate::crack::Cutter;
 use crate::math::Point;
 use crate::output::{Comparison, Probe};
+use crate::spatial::PointIndex;
+use rayon::prelude::*;
 
 /// Compares the body temperatures with the case's reference at time `t`: over all nodes,
 /// along the probe line y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the
@@ -74,4 +77,84 @@ pub fn compare(cloud: &Cloud, theta: &[f64], spec: &ReferenceSpec, t: f64) -> Co
         line_nodes: n_line,
         probe,
     }
+}
+
+/// Difference between two node fields of the same body (e.g. a refined and a uniform run).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldDifference {
+    /// max |θ_a − θ_b| over the nodes of A, °C.
+    pub max_abs: f64,
+    /// Mean |θ_a − θ_b| over the nodes of A, °C.
+    pub mean_abs: f64,
+    /// Node of A where the largest difference occurs, m.
+    pub at: Point,
+}
+
+/// Compares field A with a reference field B: B is interpolated at each node of A by a
+/// linear least-squares fit over B's 8 (3D: 12) nearest nodes that A's node sees without
+/// crossing a crack (first-order exact: a linear field interpolates without error).
+pub fn field_difference(
+    dim: usize,
+    a: (&[Point], &[f64]),
+    b: (&[Point], &[f64]),
+    cracks: &[Cutter],
+) -> FieldDifference {
+    let index = PointIndex::new(b.0);
+    let k = if dim == 3 { 12 } else { 8 };
+    let per_node: Vec<f64> =
+        a.0.par_iter()
+            .zip(a.1.par_iter())
+            .map(|(x, &ta)| {
+                let near: Vec<(usize, f64)> = index
+                    .nearest(x, 4 * k)
+                    .into_iter()
+                    .filter(|(j, _)| !cracks.iter().any(|c| c.cuts(x, &b.0[*j])))
+                    .take(k)
+                    .collect();
+                (ta - fit_at(dim, x, &near, b)).abs()
+            })
+            .collect();
+    let (imax, max_abs) = per_node
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, 0.0), |m, (i, d)| if d > m.1 { (i, d) } else { m });
+    FieldDifference {
+        max_abs,
+        mean_abs: per_node.iter().sum::<f64>() / per_node.len().max(1) as f64,
+        at: a.0.get(imax).copied().unwrap_or_else(Point::origin),
+    }
+}
+
+/// Value at `x` of the weighted linear least-squares fit through the points `near` of `b`
+/// (the nearest one's value when the fit is singular or there are too few points).
+fn fit_at(dim: usize, x: &Point, near: &[(usize, f64)], b: (&[Point], &[f64])) -> f64 {
+    let Some(&(j0, d0)) = near.first() else {
+        return f64::NAN;
+    };
+    let h = near.last().map_or(1.0, |l| l.1.max(1e-300));
+    if d0 <= 1e-9 * h {
+        return b.1[j0];
+    }
+    let n = dim + 1;
+    let mut ata = nalgebra::DMatrix::<f64>::zeros(n, n);
+    let mut atb = nalgebra::DVector::<f64>::zeros(n);
+    for &(j, d) in near {
+        let w = 1.0 / (d / h + 0.1).powi(2);
+        let dx = b.0[j] - x;
+        let mut row = vec![1.0];
+        row.extend((0..dim).map(|a| dx[a] / h));
+        for r in 0..n {
+            atb[r] += w * row[r] * b.1[j];
+            for c in 0..n {
+                ata[(r, c)] += w * row[r] * row[c];
+            }
+        }
+    }
+    if near.len() > n {
+        if let Some(sol) = ata.cholesky().map(|c| c.solve(&atb)) {
+            return sol[0];
+        }
+    }
+    b.1[j0]
 }

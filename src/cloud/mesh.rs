@@ -212,7 +212,6 @@ impl MeshGeometry {
         if let Some(ratio) = self.horizon_ratio {
             grade_horizons(&mut c, &index, ratio);
         }
-        let sides = self.sides(&cells, &new_of)?;
         let body: Vec<&Element> = perm.iter().map(|&old| cells[old]).collect();
         let locate = Locator {
             mesh,
@@ -220,13 +219,14 @@ impl MeshGeometry {
             cells: &body,
             index: &index,
         };
+        let sides = self.sides(&cells, &new_of, &locate)?;
         mirror_layers(&mut c, &sides, &locate, layered, band);
         c.sides = Sides::Mesh(Box::new(sides));
         Ok(c)
     }
 
     /// Boundary facets (by topology) and the facets of every set, in metres.
-    fn sides(&self, cells: &[&Element], new_of: &[u32]) -> Result<MeshSides> {
+    fn sides(&self, cells: &[&Element], new_of: &[u32], locate: &Locator) -> Result<MeshSides> {
         let mesh = &*self.mesh;
         let dim = self.dim();
         let s = self.scale;
@@ -300,6 +300,12 @@ impl MeshGeometry {
             .iter()
             .filter(|(_, v)| v.2 == 1)
             .map(|(k, (cell, nodes, _))| make(nodes, *cell, owner.get(k).copied()))
+            // a side facing another element is a non-conforming interface, not boundary
+            .filter(|f| {
+                let inner = Point::from(cell_centre[f.cell as usize].coords * s);
+                let step = 0.02 * (f.centre() - inner).norm();
+                !locate.inside(&(f.centre() + f.normal * step))
+            })
             .collect();
         // a deterministic order, whatever the hash map's
         let mut boundary = boundary;
