@@ -177,3 +177,72 @@ fn bad_input_fails_with_one_clear_line() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/case.toml"));
 }
+
+/// A gmsh case runs unchanged: fields with one row per mesh element, run.json; `compare`
+/// of a run with itself reports zero differences; a mesh that does not parse ends with one
+/// line naming the case, the key and the mesh file, and writes no output directory.
+#[test]
+fn gmsh_cases_run_compare_and_refuse_bad_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mesh = root.join("meshes/l_shape.msh");
+    let text = format!(
+        r#"
+dimension = 2
+[mesh]
+file = "{}"
+[[region]]
+name = "plate"
+horizon = {{ factor = 3 }}
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[boundary.left]
+type = "temperature"
+method = "mirror"
+value = 10.0
+[boundary.top]
+type = "convection"
+h = 100.0
+ambient = 0.0
+[time]
+end = 1e-6
+outputs = [5e-7, 1e-6]
+"#,
+        mesh.display()
+    );
+    let case = write_case(dir.path(), "l.toml", &text);
+    let out = dir.path().join("out");
+    let o = peritherm(&["run", &case, "--out", out.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let field = std::fs::read_to_string(out.join("field_2.csv")).unwrap();
+    assert!(field.starts_with("x,y,z,temperature,region,spacing,horizon,volume\n"));
+    assert_eq!(field.lines().count(), 1 + 4422, "one row per triangle");
+    let o = peritherm(&["compare", out.to_str().unwrap(), out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table.contains("| 0.000001 | 0.000e0 | 0.000e0 |"),
+        "{table}"
+    );
+
+    let broken = dir.path().join("broken.msh");
+    let bytes = std::fs::read(&mesh).unwrap();
+    std::fs::write(&broken, &bytes[..bytes.len() / 2]).unwrap();
+    let bad = write_case(
+        dir.path(),
+        "bad.toml",
+        &text.replace(&mesh.display().to_string(), &broken.display().to_string()),
+    );
+    let out2 = dir.path().join("out2");
+    let o = peritherm(&["run", &bad, "--out", out2.to_str().unwrap()]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("bad.toml") && err.contains("mesh.file") && err.contains("broken.msh"),
+        "{err}"
+    );
+    assert!(!out2.exists(), "no output for a failed run");
+}
