@@ -161,6 +161,15 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
         .bare_cloud()
         .with_context(|| case.path.display().to_string())?;
     let cracks = crack_cutters(&cloud, &case.spec.cracks);
+    println!("| run | nodes | bonds | steps | set-up (s) | wall (s) |");
+    println!("|---|---|---|---|---|---|");
+    for s in [&a, &b] {
+        println!(
+            "| {} | {} | {} | {} | {:.1} | {:.1} |",
+            s.case, s.nodes, s.bonds, s.steps, s.setup_seconds, s.wall_seconds
+        );
+    }
+    println!();
     println!("| t (s) | max abs diff (°C) | mean abs diff (°C) | where (m) |");
     println!("|---|---|---|---|");
     for (k, t) in a.output_times.iter().enumerate() {
