@@ -633,6 +633,15 @@ impl CaseFile {
                             format!("`{g}` also has a [boundary.{g}] condition"),
                         ));
                     }
+                    if let Geometry::Mesh(m) = geometry {
+                        if m.set_is_empty(s) {
+                            return Err(case_err(
+                                path,
+                                &key("group"),
+                                format!("the mesh's group `{g}` has no elements"),
+                            ));
+                        }
+                    }
                     CrackShape::Set(s)
                 }
                 (None, Some(pts)) => {
@@ -819,6 +828,14 @@ impl CaseFile {
                 };
                 err(&format!("boundary.{name}"), what)
             })?;
+            if let Geometry::Mesh(g) = &geometry {
+                if g.set_is_empty(f) {
+                    return Err(err(
+                        &format!("boundary.{name}"),
+                        "the mesh's physical group of this name has no elements".into(),
+                    ));
+                }
+            }
             let value = |required: bool| -> Result<Option<Expr>> {
                 match &b.value {
                     Some(v) => Ok(Some(expr(v, path, &key("value"))?)),

@@ -100,6 +100,12 @@ impl MeshGeometry {
             .collect()
     }
 
+    /// True when boundary set `s` has no element in the mesh.
+    pub fn set_is_empty(&self, s: usize) -> bool {
+        let g = self.set_groups()[s] as u16;
+        !self.mesh.elements.iter().any(|e| e.groups.contains(&g))
+    }
+
     fn region_of(&self, e: &Element) -> Result<usize> {
         e.groups
             .iter()
@@ -344,7 +350,8 @@ impl Locator<'_> {
 }
 
 /// Mirrors body nodes across the nearest facet of each layered set, then mirrors those
-/// images across a second layered set near corners; images inside the body are dropped.
+/// images across later layered sets near corners (up to one reflection per set, so corner
+/// quadrants and octants are filled); images inside the body are dropped.
 fn mirror_layers(c: &mut Cloud, sides: &MeshSides, locate: &Locator, layered: &[bool], band: f64) {
     let nb = c.n_body;
     let reach = |i: usize| 1.25 * (c.horizon[i] + band * c.spacing[i]);
@@ -372,31 +379,37 @@ fn mirror_layers(c: &mut Cloud, sides: &MeshSides, locate: &Locator, layered: &[
                 foot: f.closest(&p),
                 distance: (q - p).norm(),
             };
-            // a second reflection fills the quadrant beyond a corner with a later set
-            for (sj, other) in sides.sets.iter().enumerate().skip(si + 1) {
-                if !is_layered(sj) {
-                    continue;
+            // images of images across later sets, while the image is still within reach
+            // of them on their inner side (the region beyond a corner)
+            let mut pending = vec![(q, vec![first])];
+            while let Some((q, chain)) = pending.pop() {
+                let last = chain[0].set;
+                for (sj, other) in sides.sets.iter().enumerate().skip(last + 1) {
+                    if !is_layered(sj) {
+                        continue;
+                    }
+                    let Some((k2, _)) = other.nearest(&q) else {
+                        continue;
+                    };
+                    let f2 = &other.facets[k2];
+                    let d2 = -f2.outward_distance(&q);
+                    if d2 <= 0.0 || d2 > reach(i) {
+                        continue;
+                    }
+                    let q2 = f2.reflect(&q);
+                    if locate.inside(&q2) {
+                        continue;
+                    }
+                    let mut longer = vec![Reflection {
+                        set: sj,
+                        foot: f2.closest(&q),
+                        distance: (q2 - q).norm(),
+                    }];
+                    longer.extend(chain.iter().cloned());
+                    pending.push((q2, longer));
                 }
-                let Some((k2, _)) = other.nearest(&q) else {
-                    continue;
-                };
-                let f2 = &other.facets[k2];
-                let d2 = -f2.outward_distance(&q);
-                if d2 <= 0.0 || d2 > reach(i) {
-                    continue;
-                }
-                let q2 = f2.reflect(&q);
-                if locate.inside(&q2) {
-                    continue;
-                }
-                let second = Reflection {
-                    set: sj,
-                    foot: f2.closest(&q),
-                    distance: (q2 - q).norm(),
-                };
-                ghosts.push((i, q2, vec![second, first.clone()]));
+                ghosts.push((i, q, chain));
             }
-            ghosts.push((i, q, vec![first]));
         }
     }
     for (i, q, chain) in ghosts {

@@ -98,6 +98,31 @@ def cube_hex():
     write("cube_hex.msh")
 
 
+def cube_hex_faces():
+    """Unit cube of 5 × 5 × 5 hexahedra with all six faces named x_min ... z_max."""
+    start("cube_hex_faces")
+    box = gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    for dim, tag in gmsh.model.getEntities(1):
+        gmsh.model.mesh.setTransfiniteCurve(tag, 6)
+    for dim, tag in gmsh.model.getEntities(2):
+        gmsh.model.mesh.setTransfiniteSurface(tag)
+        gmsh.model.mesh.setRecombine(2, tag)
+    gmsh.model.mesh.setTransfiniteVolume(box)
+    gmsh.model.addPhysicalGroup(3, [box], name="block")
+    eps = 1e-3  # OpenCASCADE pads bounding boxes, so the search box must be wider
+    for name, (axis, value) in {"x_min": (0, 0.0), "x_max": (0, 1.0), "y_min": (1, 0.0),
+                                "y_max": (1, 1.0), "z_min": (2, 0.0), "z_max": (2, 1.0)}.items():
+        lo = [-eps] * 3
+        hi = [1 + eps] * 3
+        lo[axis] = value - eps
+        hi[axis] = value + eps
+        faces = gmsh.model.getEntitiesInBoundingBox(*lo, *hi, dim=2)
+        gmsh.model.addPhysicalGroup(2, [t for _, t in faces], name=name)
+    gmsh.model.mesh.generate(3)
+    write("cube_hex_faces.msh")
+
+
 def cube_tet():
     start("cube_tet")
     box = gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
@@ -133,7 +158,7 @@ def second_order():
 if __name__ == "__main__":
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
-    for make in [square_tri, square_quad, line, cube_hex, cube_tet, no_groups, second_order,
+    for make in [square_tri, square_quad, line, cube_hex, cube_hex_faces, cube_tet, no_groups, second_order,
                  unmeshed]:
         make()
     gmsh.finalize()
