@@ -94,15 +94,25 @@ impl Cutter {
     }
 }
 
-/// Splits a planar polygon facet (3 or 4 corners) into triangles for [`Cutter`].
-pub fn triangles(corners: &[Point]) -> Vec<Vec<Point>> {
-    match corners.len() {
+/// Cutters of one planar facet: a point, a segment or a triangle as is, a quadrangle split
+/// in two triangles. Segment ends count as interior vertices (a boundary has no tips).
+pub fn facet_cutters(corners: &[Point], mu: f64, boundary: Option<Option<u16>>) -> Vec<Cutter> {
+    let parts = match corners.len() {
         4 => vec![
             vec![corners[0], corners[1], corners[2]],
             vec![corners[0], corners[2], corners[3]],
         ],
         _ => vec![corners.to_vec()],
-    }
+    };
+    parts
+        .into_iter()
+        .map(|corners| Cutter {
+            corners,
+            tips: [false; 2],
+            mu,
+            boundary,
+        })
+        .collect()
 }
 
 /// The conductance fraction μ of every directed bond of `horizons` (1 where nothing cuts it).

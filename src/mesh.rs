@@ -111,7 +111,7 @@ fn tet_volume(a: &Point, b: &Point, c: &Point, d: &Point) -> f64 {
 }
 
 /// Gmsh's hexahedron split into six tetrahedra around the diagonal 0–6.
-const HEX_TETS: [[usize; 4]; 6] = [
+pub const HEX_TETS: [[usize; 4]; 6] = [
     [0, 1, 2, 6],
     [0, 2, 3, 6],
     [0, 3, 7, 6],

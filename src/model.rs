@@ -4,7 +4,7 @@ use crate::bc::{Boundary, BoundaryInput, FaceBc};
 use crate::cloud::mesh::MeshGeometry;
 use crate::cloud::{BoxGeometry, Cloud, Sides};
 use crate::consistency::{correct, Correction};
-use crate::crack::{bond_factors, segments, triangles, Cutter};
+use crate::crack::{bond_factors, facet_cutters, segments, Cutter};
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Kernel, PartialVolume};
@@ -104,14 +104,7 @@ pub fn crack_cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
                     out.extend(segments(&pairs, c.mu));
                 } else {
                     for f in facets {
-                        for t in triangles(&f.corners) {
-                            out.push(Cutter {
-                                corners: t,
-                                tips: [false; 2],
-                                mu: c.mu,
-                                boundary: None,
-                            });
-                        }
+                        out.extend(facet_cutters(&f.corners, c.mu, None));
                     }
                 }
             }
@@ -125,14 +118,7 @@ fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
     let mut out = crack_cutters(cloud, cracks);
     if let Sides::Mesh(m) = &cloud.sides {
         for f in &m.boundary.facets {
-            for t in triangles(&f.corners) {
-                out.push(Cutter {
-                    corners: t,
-                    tips: [false; 2],
-                    mu: 0.0,
-                    boundary: Some(f.set),
-                });
-            }
+            out.extend(facet_cutters(&f.corners, 0.0, Some(f.set)));
         }
     }
     out

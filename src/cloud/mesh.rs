@@ -7,7 +7,7 @@ use super::order::morton_order;
 use super::{Cloud, Fictitious, HorizonRule, MeshSides, Reflection, Sides};
 use crate::error::{Error, Result};
 use crate::math::{NodeId, Point, Vector};
-use crate::mesh::{measure_and_centroid, Element, ElementKind, Mesh};
+use crate::mesh::{measure_and_centroid, Element, ElementKind, Mesh, HEX_TETS};
 use crate::spatial::PointIndex;
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -302,7 +302,7 @@ impl MeshGeometry {
             }
             sets.push(FacetSet::new(list));
         }
-        let boundary: Vec<Facet> = faces
+        let mut boundary: Vec<Facet> = faces
             .iter()
             .filter(|(_, v)| v.2 == 1)
             .map(|(k, (cell, nodes, _))| make(nodes, *cell, owner.get(k).copied()))
@@ -314,13 +314,9 @@ impl MeshGeometry {
             })
             .collect();
         // a deterministic order, whatever the hash map's
-        let mut boundary = boundary;
-        boundary.sort_by(|a, b| {
-            a.cell
-                .cmp(&b.cell)
-                .then(a.centre().coords.x.total_cmp(&b.centre().coords.x))
-                .then(a.centre().coords.y.total_cmp(&b.centre().coords.y))
-                .then(a.centre().coords.z.total_cmp(&b.centre().coords.z))
+        boundary.sort_by_cached_key(|f| {
+            let c = f.centre();
+            (f.cell, [c.x, c.y, c.z].map(f64::to_bits))
         });
         Ok(MeshSides {
             names: self.set_names(),
@@ -459,16 +455,9 @@ fn element_contains(kind: ElementKind, c: &[Point], p: &Point) -> bool {
         ElementKind::Triangle => tri(&c[0], &c[1], &c[2]),
         ElementKind::Quad => tri(&c[0], &c[1], &c[2]) || tri(&c[0], &c[2], &c[3]),
         ElementKind::Tet => tet(&c[0], &c[1], &c[2], &c[3]),
-        ElementKind::Hex => [
-            [0, 1, 2, 6],
-            [0, 2, 3, 6],
-            [0, 3, 7, 6],
-            [0, 7, 4, 6],
-            [0, 4, 5, 6],
-            [0, 5, 1, 6],
-        ]
-        .iter()
-        .any(|t| tet(&c[t[0]], &c[t[1]], &c[t[2]], &c[t[3]])),
+        ElementKind::Hex => HEX_TETS
+            .iter()
+            .any(|t| tet(&c[t[0]], &c[t[1]], &c[t[2]], &c[t[3]])),
     }
 }
 
