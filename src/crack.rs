@@ -181,6 +181,28 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> V
     mu
 }
 
+/// Damage of every body node (formulation §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
+/// the directed bonds of i (0 intact, 1 with every bond cut).
+pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {
+    (0..cloud.n_body)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|i| {
+            let (mut kept, mut all) = (0.0, 0.0);
+            for b in horizons.row(i) {
+                let v = horizons.beta[b] * cloud.volume[horizons.targets[b] as usize];
+                kept += mu[b] * v;
+                all += v;
+            }
+            if all > 0.0 {
+                1.0 - kept / all
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

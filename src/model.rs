@@ -145,6 +145,8 @@ pub struct Model {
     pub theta0: Vec<f64>,
     /// Result of the linear-consistency correction, when it was asked for.
     pub correction: Option<Correction>,
+    /// Damage φ of every body node (formulation §5).
+    pub damage: Vec<f64>,
 }
 
 impl Model {
@@ -196,6 +198,13 @@ impl Model {
         );
         let cutters = cutters(&cloud, &spec.cracks);
         let mu = bond_factors(&cloud, &horizons, &cutters);
+        // damage counts cracks only: bonds the boundary cuts (holes, notches) never existed
+        let damage = if spec.cracks.is_empty() {
+            vec![0.0; cloud.n_body]
+        } else {
+            let cracks = crack_cutters(&cloud, &spec.cracks);
+            crate::crack::damage(&cloud, &horizons, &bond_factors(&cloud, &horizons, &cracks))
+        };
         for (w, m) in weights.iter_mut().zip(&mu) {
             *w *= m;
         }
@@ -276,6 +285,7 @@ impl Model {
             boundary,
             theta0,
             correction,
+            damage,
         })
     }
 

@@ -7,7 +7,7 @@
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
 use crate::material::BondRule;
-use crate::math::NodeId;
+use crate::math::{NodeId, Vector};
 use crate::neighbors::Horizons;
 use rayon::prelude::*;
 
@@ -185,6 +185,29 @@ impl Conductance {
         for (i, o) in out.iter_mut().enumerate() {
             *o = self.row_flow(i, theta);
         }
+    }
+
+    /// Peridynamic heat flux of every body node (formulation §8, seed 003 §2.2), W/m²:
+    /// q_i = −(1/V_i) Σ_{j hotter than i} K_ij (θ_j − θ_i) ξ_ij. With K_ij = V_i V_j c β this is
+    /// the paper's sum over H⁺; it equals −k∇θ for a linear field in the bulk and stays finite
+    /// at corners and crack tips.
+    pub fn flux(&self, cloud: &Cloud, theta: &[f64]) -> Vec<Vector> {
+        (0..self.n_rows())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                let ti = theta[i];
+                let mut q = Vector::zeros();
+                for e in self.offsets[i]..self.offsets[i + 1] {
+                    let j = self.cols[e] as usize;
+                    let dt = theta[j] - ti;
+                    if dt > 0.0 {
+                        q -= (cloud.pos[j] - cloud.pos[i]) * (self.vals[e] * dt);
+                    }
+                }
+                q / cloud.volume[i]
+            })
+            .collect()
     }
 
     /// The entry K_ij if stored, else 0, W/K.

@@ -1,11 +1,12 @@
 //! Output files: fields as CSV, the run summary as JSON, each written atomically.
 //!
 //! Contract: for the k-th output time (k from 1), `field_<k>.csv` with the columns
-//! `x,y,z,temperature,region,spacing,horizon,volume`, one row per body node; and `run.json`.
+//! `x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz`, one row per body
+//! node, and the same fields as a VTK unstructured grid `field_<k>.vtu`; and `run.json`.
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
-use crate::math::Point;
+use crate::math::{Point, Vector};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -30,17 +31,134 @@ pub fn field_path(dir: &Path, k: usize) -> PathBuf {
     dir.join(format!("field_{k}.csv"))
 }
 
-/// CSV text of the body nodes' temperatures.
-pub fn field_csv(cloud: &Cloud, theta: &[f64]) -> String {
-    let mut s = String::with_capacity(cloud.n_body * 80);
-    s.push_str("x,y,z,temperature,region,spacing,horizon,volume\n");
-    for (i, (p, t)) in cloud.pos.iter().zip(theta).take(cloud.n_body).enumerate() {
+/// Path of the k-th VTK file (k from 1).
+pub fn vtu_path(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("field_{k}.vtu"))
+}
+
+/// One output time's body fields: temperature and what is derived from it.
+pub struct Fields<'a> {
+    /// Temperature of every node (body first), °C.
+    pub theta: &'a [f64],
+    /// Damage φ per body node (formulation §5).
+    pub damage: &'a [f64],
+    /// Peridynamic heat flux per body node (formulation §8), W/m².
+    pub flux: &'a [Vector],
+}
+
+/// CSV text of the body nodes: position, temperature, region, spacing, horizon, volume,
+/// damage and heat flux.
+pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
+    let mut s = String::with_capacity(cloud.n_body * 120);
+    s.push_str("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz\n");
+    for i in 0..cloud.n_body {
+        let (p, q) = (cloud.pos[i], f.flux[i]);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{}",
-            p.x, p.y, p.z, t, cloud.region[i], cloud.spacing[i], cloud.horizon[i], cloud.volume[i]
+            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            p.x,
+            p.y,
+            p.z,
+            f.theta[i],
+            cloud.region[i],
+            cloud.spacing[i],
+            cloud.horizon[i],
+            cloud.volume[i],
+            f.damage[i],
+            q.x,
+            q.y,
+            q.z
         );
     }
+    s
+}
+
+const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Appends the standard base64 encoding of `bytes` (with padding).
+fn base64(bytes: &[u8], out: &mut String) {
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(B64[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+}
+
+/// A VTK XML `DataArray` in inline binary form: base64 of the byte count (UInt64), then
+/// base64 of the little-endian values, encoded separately as VTK's own writer does.
+fn vtk_array(out: &mut String, kind: &str, name: &str, comps: usize, bytes: &[u8]) {
+    let _ = write!(
+        out,
+        "<DataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">"
+    );
+    base64(&(bytes.len() as u64).to_le_bytes(), out);
+    base64(bytes, out);
+    out.push_str("</DataArray>\n");
+}
+
+fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
+    v.flat_map(f64::to_le_bytes).collect()
+}
+
+/// A VTK unstructured grid (`.vtu`) of the body nodes as vertices, with temperature, heat
+/// flux, damage, horizon, spacing, volume and region, for ParaView.
+pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
+    let n = cloud.n_body;
+    let mut s = String::with_capacity(n * 140);
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n");
+    let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">");
+    s.push_str("<PointData Scalars=\"temperature\" Vectors=\"flux\">\n");
+    vtk_array(
+        &mut s,
+        "Float64",
+        "temperature",
+        1,
+        &f64_bytes(f.theta[..n].iter().copied()),
+    );
+    let flux = f.flux.iter().flat_map(|q| [q.x, q.y, q.z]);
+    vtk_array(&mut s, "Float64", "flux", 3, &f64_bytes(flux));
+    vtk_array(
+        &mut s,
+        "Float64",
+        "damage",
+        1,
+        &f64_bytes(f.damage.iter().copied()),
+    );
+    for (name, v) in [
+        ("horizon", &cloud.horizon),
+        ("spacing", &cloud.spacing),
+        ("volume", &cloud.volume),
+    ] {
+        vtk_array(
+            &mut s,
+            "Float64",
+            name,
+            1,
+            &f64_bytes(v[..n].iter().copied()),
+        );
+    }
+    let region: Vec<u8> = cloud.region[..n]
+        .iter()
+        .flat_map(|r| (*r as i32).to_le_bytes())
+        .collect();
+    vtk_array(&mut s, "Int32", "region", 1, &region);
+    s.push_str("</PointData>\n<Points>\n");
+    let pos = cloud.pos[..n].iter().flat_map(|p| [p.x, p.y, p.z]);
+    vtk_array(&mut s, "Float64", "Points", 3, &f64_bytes(pos));
+    s.push_str("</Points>\n<Cells>\n");
+    let ids: Vec<u8> = (0..n as i64).flat_map(i64::to_le_bytes).collect();
+    vtk_array(&mut s, "Int64", "connectivity", 1, &ids);
+    let offsets: Vec<u8> = (1..=n as i64).flat_map(i64::to_le_bytes).collect();
+    vtk_array(&mut s, "Int64", "offsets", 1, &offsets);
+    vtk_array(&mut s, "UInt8", "types", 1, &vec![1u8; n]); // VTK_VERTEX
+    s.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     s
 }
 
@@ -214,5 +332,26 @@ impl RunSummary {
     pub fn write(&self, dir: &Path) -> Result<()> {
         let json = serde_json::to_string_pretty(self).expect("plain data serialises");
         write_atomic(&dir.join("run.json"), json.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::base64;
+
+    /// RFC 4648 test vectors.
+    #[test]
+    fn base64_vectors() {
+        for (raw, enc) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            let mut s = String::new();
+            base64(raw.as_bytes(), &mut s);
+            assert_eq!(s, enc);
+        }
     }
 }

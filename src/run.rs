@@ -3,7 +3,7 @@
 use crate::case::Case;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::output::{field_csv, field_path, write_atomic, RunSummary};
+use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
 use crate::report::compare;
 use crate::solve::explicit::{choose_dt, count_steps, Explicit};
 use std::path::Path;
@@ -50,7 +50,14 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         |k, t, th| {
             energy.push(model.energy(th));
             let path = field_path(out, k + 1);
-            write_atomic(&path, field_csv(&model.cloud, th).as_bytes())?;
+            let flux = model.conductance.flux(&model.cloud, th);
+            let f = Fields {
+                theta: th,
+                damage: &model.damage,
+                flux: &flux,
+            };
+            write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+            write_atomic(&vtu_path(out, k + 1), field_vtu(&model.cloud, &f).as_bytes())?;
             fields.push(
                 path.file_name()
                     .expect("file")

@@ -70,8 +70,30 @@ fn run_honours_the_output_contract() {
     for k in 1..=2 {
         let text = std::fs::read_to_string(out.join(format!("field_{k}.csv"))).unwrap();
         let mut lines = text.lines();
-        assert!(lines.next().unwrap().starts_with("x,y,z,temperature"));
+        assert_eq!(
+            lines.next().unwrap(),
+            "x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz"
+        );
         assert_eq!(lines.count(), nodes);
+        // the same fields for ParaView, one vertex per body node
+        let vtu = std::fs::read_to_string(out.join(format!("field_{k}.vtu"))).unwrap();
+        assert!(vtu.starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\""));
+        assert!(vtu.contains(&format!(
+            "<Piece NumberOfPoints=\"{nodes}\" NumberOfCells=\"{nodes}\">"
+        )));
+        for name in [
+            "temperature",
+            "flux",
+            "damage",
+            "horizon",
+            "spacing",
+            "region",
+        ] {
+            assert!(
+                vtu.contains(&format!("Name=\"{name}\"")),
+                "vtu lacks {name}"
+            );
+        }
     }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
@@ -217,7 +239,7 @@ outputs = [5e-7, 1e-6]
     let o = peritherm(&["run", &case, "--out", out.to_str().unwrap(), "-q"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let field = std::fs::read_to_string(out.join("field_2.csv")).unwrap();
-    assert!(field.starts_with("x,y,z,temperature,region,spacing,horizon,volume\n"));
+    assert!(field.starts_with("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz\n"));
     assert_eq!(field.lines().count(), 1 + 4422, "one row per triangle");
     let o = peritherm(&["compare", out.to_str().unwrap(), out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
