@@ -7,6 +7,7 @@ use crate::analytic::Reference;
 use crate::bc::{FaceBc, Layer};
 use crate::cloud::mesh::{MeshGeometry, MeshRegion};
 use crate::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
+use crate::crack::Growth;
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
@@ -121,6 +122,15 @@ pub struct CrackSpec {
     /// Conductance fraction μ kept across the crack (default 0: insulated).
     #[serde(default)]
     pub conductance: Option<f64>,
+    /// Tip speed of a crack growing along `points` from the first one, m/s.
+    #[serde(default)]
+    pub speed: Option<f64>,
+    /// Time the tip starts moving, s (default 0).
+    #[serde(default)]
+    pub start: Option<f64>,
+    /// Length already cracked from the first point, m (default 0).
+    #[serde(default)]
+    pub initial_length: Option<f64>,
 }
 
 /// Node placement.
@@ -670,7 +680,55 @@ impl CaseFile {
                     ))
                 }
             };
-            out.push(Crack { shape, mu });
+            let growth = match spec.speed {
+                None => {
+                    for (k, present) in [
+                        ("start", spec.start.is_some()),
+                        ("initial_length", spec.initial_length.is_some()),
+                    ] {
+                        if present {
+                            return Err(case_err(
+                                path,
+                                &key(k),
+                                "applies to a growing crack: give speed too",
+                            ));
+                        }
+                    }
+                    None
+                }
+                Some(v) => {
+                    if spec.points.is_none() {
+                        return Err(case_err(
+                            path,
+                            &key("speed"),
+                            "a growing crack follows a polyline: give points",
+                        ));
+                    }
+                    let start = spec.start.unwrap_or(0.0);
+                    if !(start.is_finite() && start >= 0.0) {
+                        return Err(case_err(
+                            path,
+                            &key("start"),
+                            format!("must be a time >= 0, got {start}"),
+                        ));
+                    }
+                    let initial = spec.initial_length.unwrap_or(0.0);
+                    if !(initial.is_finite() && initial >= 0.0) {
+                        return Err(case_err(
+                            path,
+                            &key("initial_length"),
+                            format!("must be a length >= 0, got {initial}"),
+                        ));
+                    }
+                    Some(Growth {
+                        start,
+                        speed: positive(path, &key("speed"), v)?,
+                        initial,
+                        arc: 0.0,
+                    })
+                }
+            };
+            out.push(Crack { shape, mu, growth });
         }
         Ok(out)
     }

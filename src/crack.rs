@@ -25,6 +25,44 @@ pub struct Cutter {
     pub mu: f64,
     /// For a boundary facet, its set (`Some(None)` for a facet in no set); None for a crack.
     pub boundary: Option<Option<u16>>,
+    /// For a segment of a growing crack, how its tip advances; None for a standing crack.
+    pub growth: Option<Growth>,
+}
+
+/// A crack that grows along its polyline from the first point at a constant speed
+/// (seed 003 Example 5): at time t it covers the path up to arc length
+/// `initial + speed (t − start)`, and each bond is cut when the tip passes its crossing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Growth {
+    /// Time the tip starts moving, s.
+    pub start: f64,
+    /// Tip speed along the path, m/s.
+    pub speed: f64,
+    /// Length cracked from the start, m.
+    pub initial: f64,
+    /// Arc length of this segment's first corner along the path, m (set by [`growing_path`]).
+    pub arc: f64,
+}
+
+/// The segments of a crack that grows along `points` from the first one.
+pub fn growing_path(points: &[Point], mu: f64, growth: Growth) -> Vec<Cutter> {
+    let pairs: Vec<[Point; 2]> = points.windows(2).map(|w| [w[0], w[1]]).collect();
+    let mut arc = 0.0;
+    let mut out = segments(&pairs, mu);
+    for (c, p) in out.iter_mut().zip(&pairs) {
+        c.growth = Some(Growth { arc, ..growth });
+        arc += (p[1] - p[0]).norm();
+    }
+    out
+}
+
+/// Bond cuts: the fraction μ of every directed bond now, and the later cuts of growing cracks.
+#[derive(Debug, Clone, Default)]
+pub struct Cuts {
+    /// μ per directed bond at t = 0 (1 where nothing cuts it).
+    pub mu: Vec<f64>,
+    /// (directed bond, time it is cut, μ it keeps), for bonds a growing crack reaches later.
+    pub later: Vec<(usize, f64, f64)>,
 }
 
 /// Crack segments of one polyline or facet group, with tips found by vertex degree.
@@ -43,6 +81,7 @@ pub fn segments(pairs: &[[Point; 2]], mu: f64) -> Vec<Cutter> {
             tips: [degree[&key(&s[0])] == 1, degree[&key(&s[1])] == 1],
             mu,
             boundary: None,
+            growth: None,
         })
         .collect()
 }
@@ -58,16 +97,25 @@ fn orient3(a: &Point, b: &Point, c: &Point, d: &Point) -> f64 {
 impl Cutter {
     /// True when the bond from `a` to `b` crosses this facet.
     pub fn cuts(&self, a: &Point, b: &Point) -> bool {
+        self.crossing(a, b).is_some()
+    }
+
+    /// Where the bond from `a` to `b` crosses this facet: the fraction of the way from the
+    /// first corner to the second for a segment (0 for points and triangles), or None.
+    pub fn crossing(&self, a: &Point, b: &Point) -> Option<f64> {
         let c = &self.corners;
-        match c.len() {
+        let hit = match c.len() {
             1 => (a.x - c[0].x) * (b.x - c[0].x) < 0.0,
             2 => {
                 let (o3, o4) = (orient2(&c[0], &c[1], a), orient2(&c[0], &c[1], b));
                 if o3 * o4 >= 0.0 {
-                    return false;
+                    return None;
                 }
                 let (o1, o2) = (orient2(a, b, &c[0]), orient2(a, b, &c[1]));
-                o1 * o2 < 0.0 || (o1 == 0.0 && !self.tips[0]) || (o2 == 0.0 && !self.tips[1])
+                if o1 * o2 < 0.0 || (o1 == 0.0 && !self.tips[0]) || (o2 == 0.0 && !self.tips[1]) {
+                    return Some(o1 / (o1 - o2));
+                }
+                false
             }
             _ => {
                 let (sa, sb) = (
@@ -75,14 +123,33 @@ impl Cutter {
                     orient3(&c[0], &c[1], &c[2], b),
                 );
                 if sa * sb >= 0.0 {
-                    return false;
+                    return None;
                 }
                 let u = orient3(a, b, &c[0], &c[1]);
                 let v = orient3(a, b, &c[1], &c[2]);
                 let w = orient3(a, b, &c[2], &c[0]);
                 (u >= 0.0 && v >= 0.0 && w >= 0.0) || (u <= 0.0 && v <= 0.0 && w <= 0.0)
             }
-        }
+        };
+        hit.then_some(0.0)
+    }
+
+    /// When this facet cuts the bond from `a` to `b`: −∞ for a standing crack or a part of a
+    /// growing one cracked from the start, the moment its tip passes the crossing otherwise
+    /// (s); None when the bond does not cross.
+    pub fn cut_time(&self, a: &Point, b: &Point) -> Option<f64> {
+        let u = self.crossing(a, b)?;
+        Some(match self.growth {
+            None => f64::NEG_INFINITY,
+            Some(g) => {
+                let s = g.arc + u * (self.corners[1] - self.corners[0]).norm();
+                if s <= g.initial {
+                    f64::NEG_INFINITY
+                } else {
+                    g.start + (s - g.initial) / g.speed
+                }
+            }
+        })
     }
 
     fn centre(&self) -> Point {
@@ -111,16 +178,21 @@ pub fn facet_cutters(corners: &[Point], mu: f64, boundary: Option<Option<u16>>) 
             tips: [false; 2],
             mu,
             boundary,
+            growth: None,
         })
         .collect()
 }
 
-/// The conductance fraction μ of every directed bond of `horizons` (1 where nothing cuts it).
-/// Each pair is tested with its ends in index order, so μ_ij = μ_ji bit for bit.
-pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> Vec<f64> {
+/// The conductance fraction μ of every directed bond of `horizons` (1 where nothing cuts it)
+/// and the later cuts of growing cracks. Each pair is tested with its ends in index order, so
+/// μ_ij = μ_ji bit for bit.
+pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> Cuts {
     let mut mu = vec![1.0; horizons.n_bonds()];
     if cutters.is_empty() {
-        return mu;
+        return Cuts {
+            mu,
+            later: Vec::new(),
+        };
     }
     let centres: Vec<Point> = cutters.iter().map(Cutter::centre).collect();
     let radius = cutters
@@ -143,42 +215,57 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> V
         rows.push((i, a));
         rest = b;
     }
-    rows.into_par_iter().with_min_len(64).for_each(|(i, slot)| {
-        let range = horizons.row(i);
-        let reach = range
-            .clone()
-            .map(|b| (cloud.pos[horizons.targets[b] as usize] - cloud.pos[i]).norm())
-            .fold(0.0, f64::max);
-        let near = index.within(&cloud.pos[i], reach + radius);
-        if near.is_empty() {
-            return;
-        }
-        for (m, b) in slot.iter_mut().zip(range) {
-            let j = horizons.targets[b] as usize;
-            let (lo, hi) = (i.min(j), i.max(j));
-            let (a, z) = (&cloud.pos[lo], &cloud.pos[hi]);
-            for &k in &near {
-                let c = &cutters[k];
-                if !c.cuts(a, z) {
-                    continue;
-                }
-                *m = match c.boundary {
-                    None => m.min(c.mu),
-                    // a body-body bond that leaves the body, or a ghost's bond across a
-                    // set it was not mirrored across
-                    Some(set) => {
-                        let allowed = hi >= nb && set.is_some_and(|s| mirrored_across(hi, s));
-                        if allowed {
-                            *m
-                        } else {
-                            0.0
+    let later: Vec<(usize, f64, f64)> = rows
+        .into_par_iter()
+        .with_min_len(64)
+        .flat_map_iter(|(i, slot)| {
+            let range = horizons.row(i);
+            let reach = range
+                .clone()
+                .map(|b| (cloud.pos[horizons.targets[b] as usize] - cloud.pos[i]).norm())
+                .fold(0.0, f64::max);
+            let near = index.within(&cloud.pos[i], reach + radius);
+            let mut later = Vec::new();
+            if near.is_empty() {
+                return later;
+            }
+            for (m, b) in slot.iter_mut().zip(range) {
+                let j = horizons.targets[b] as usize;
+                let (lo, hi) = (i.min(j), i.max(j));
+                let (a, z) = (&cloud.pos[lo], &cloud.pos[hi]);
+                // the earliest cut of a growing crack, and the μ it leaves
+                let mut first: Option<(f64, f64)> = None;
+                for &k in &near {
+                    let c = &cutters[k];
+                    let Some(t) = c.cut_time(a, z) else {
+                        continue;
+                    };
+                    match c.boundary {
+                        None if t == f64::NEG_INFINITY => *m = m.min(c.mu),
+                        None => {
+                            if first.is_none_or(|f| t < f.0) {
+                                first = Some((t, c.mu));
+                            }
+                        }
+                        // a body-body bond that leaves the body, or a ghost's bond across a
+                        // set it was not mirrored across
+                        Some(set) => {
+                            if !(hi >= nb && set.is_some_and(|s| mirrored_across(hi, s))) {
+                                *m = 0.0;
+                            }
                         }
                     }
-                };
+                }
+                if let Some((t, keep)) = first {
+                    if keep < 1.0 && *m > 0.0 {
+                        later.push((b, t, keep));
+                    }
+                }
             }
-        }
-    });
-    mu
+            later
+        })
+        .collect();
+    Cuts { mu, later }
 }
 
 /// Damage of every body node (formulation §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
@@ -247,6 +334,7 @@ mod tests {
             tips: [false; 2],
             mu: 0.0,
             boundary: None,
+            growth: None,
         };
         assert!(t.cuts(&Point::new(0.2, 0.2, -1.0), &Point::new(0.2, 0.2, 1.0)));
         assert!(!t.cuts(&Point::new(0.8, 0.8, -1.0), &Point::new(0.8, 0.8, 1.0)));

@@ -4,7 +4,9 @@ use crate::bc::{Boundary, BoundaryInput, FaceBc};
 use crate::cloud::mesh::MeshGeometry;
 use crate::cloud::{BoxGeometry, Cloud, Sides};
 use crate::consistency::{correct, Correction};
-use crate::crack::{bond_factors, facet_cutters, segments, Cutter};
+use crate::crack::{
+    bond_factors, damage, facet_cutters, growing_path, segments, Cuts, Cutter, Growth,
+};
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Kernel, PartialVolume};
@@ -57,6 +59,8 @@ pub struct Crack {
     pub shape: CrackShape,
     /// Conductance fraction μ kept by the bonds it cuts (0 = insulated).
     pub mu: f64,
+    /// How a polyline crack grows from its first point; None for a standing crack.
+    pub growth: Option<Growth>,
 }
 
 /// Everything that defines a model, independent of any file format.
@@ -87,10 +91,13 @@ pub fn crack_cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
     let mut out = Vec::new();
     for c in cracks {
         match &c.shape {
-            CrackShape::Polyline(pts) => {
-                let pairs: Vec<[Point; 2]> = pts.windows(2).map(|w| [w[0], w[1]]).collect();
-                out.extend(segments(&pairs, c.mu));
-            }
+            CrackShape::Polyline(pts) => match c.growth {
+                Some(g) => out.extend(growing_path(pts, c.mu, g)),
+                None => {
+                    let pairs: Vec<[Point; 2]> = pts.windows(2).map(|w| [w[0], w[1]]).collect();
+                    out.extend(segments(&pairs, c.mu));
+                }
+            },
             CrackShape::Set(s) => {
                 let Sides::Mesh(m) = &cloud.sides else {
                     continue;
@@ -145,8 +152,62 @@ pub struct Model {
     pub theta0: Vec<f64>,
     /// Result of the linear-consistency correction, when it was asked for.
     pub correction: Option<Correction>,
-    /// Damage φ of every body node (formulation §5).
-    pub damage: Vec<f64>,
+    /// Later cuts of pairs by growing cracks, in time order.
+    pub growth: Vec<PairCut>,
+    /// Cuts of the directed bonds by cracks alone (for damage).
+    pub crack_cuts: Cuts,
+}
+
+/// A pair that a growing crack cuts at `time`: its K entries keep the fraction `mu`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairCut {
+    /// When the tip passes the pair, s.
+    pub time: f64,
+    /// Fraction kept.
+    pub mu: f64,
+    /// (row, index into the CSR arrays) of K_ij and K_ji; rows of fictitious nodes are absent.
+    pub entries: [Option<(usize, usize)>; 2],
+}
+
+/// The K entries of the pairs in `later` (directed bonds cut later), earliest cut per pair.
+fn pair_cuts(
+    cloud: &Cloud,
+    horizons: &Horizons,
+    k: &Conductance,
+    later: &[(usize, f64, f64)],
+) -> Vec<PairCut> {
+    let mut rows = vec![0usize; horizons.n_bonds()];
+    for i in 0..horizons.len() {
+        for b in horizons.row(i) {
+            rows[b] = i;
+        }
+    }
+    let mut pairs: std::collections::BTreeMap<(usize, usize), (f64, f64)> = Default::default();
+    for &(b, t, mu) in later {
+        let (i, j) = (rows[b], horizons.targets[b] as usize);
+        let e = pairs.entry((i.min(j), i.max(j))).or_insert((t, mu));
+        if t < e.0 {
+            *e = (t, mu);
+        }
+    }
+    let entry = |r: usize, c: usize| -> Option<(usize, usize)> {
+        if r >= cloud.n_body {
+            return None;
+        }
+        let range = k.offsets[r]..k.offsets[r + 1];
+        let p = k.cols[range.clone()].binary_search(&(c as u32)).ok()?;
+        Some((r, range.start + p))
+    };
+    let mut out: Vec<PairCut> = pairs
+        .into_iter()
+        .map(|((i, j), (time, mu))| PairCut {
+            time,
+            mu,
+            entries: [entry(i, j), entry(j, i)],
+        })
+        .collect();
+    out.sort_by(|a, b| a.time.total_cmp(&b.time));
+    out
 }
 
 impl Model {
@@ -197,15 +258,15 @@ impl Model {
             spec.bond_rule,
         );
         let cutters = cutters(&cloud, &spec.cracks);
-        let mu = bond_factors(&cloud, &horizons, &cutters);
+        let cuts = bond_factors(&cloud, &horizons, &cutters);
+        let mu = &cuts.mu;
         // damage counts cracks only: bonds the boundary cuts (holes, notches) never existed
-        let damage = if spec.cracks.is_empty() {
-            vec![0.0; cloud.n_body]
+        let crack_cuts = if spec.cracks.is_empty() {
+            Cuts::default()
         } else {
-            let cracks = crack_cutters(&cloud, &spec.cracks);
-            crate::crack::damage(&cloud, &horizons, &bond_factors(&cloud, &horizons, &cracks))
+            bond_factors(&cloud, &horizons, &crack_cutters(&cloud, &spec.cracks))
         };
-        for (w, m) in weights.iter_mut().zip(&mu) {
+        for (w, m) in weights.iter_mut().zip(mu) {
             *w *= m;
         }
         let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
@@ -237,6 +298,7 @@ impl Model {
             .iter()
             .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
             && cloud.dim > 1;
+        let growth = pair_cuts(&cloud, &horizons, &conductance, &cuts.later);
         let micro: Vec<f64> = if needs_micro {
             (0..horizons.len())
                 .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
@@ -285,8 +347,24 @@ impl Model {
             boundary,
             theta0,
             correction,
-            damage,
+            growth,
+            crack_cuts,
         })
+    }
+
+    /// Damage φ of every body node at time `t` (formulation §5), growing cracks included.
+    pub fn damage_at(&self, t: f64) -> Vec<f64> {
+        let c = &self.crack_cuts;
+        if c.mu.is_empty() {
+            return vec![0.0; self.cloud.n_body];
+        }
+        let mut mu = c.mu.clone();
+        for &(b, tc, m) in &c.later {
+            if tc <= t {
+                mu[b] = mu[b].min(m);
+            }
+        }
+        damage(&self.cloud, &self.horizons, &mu)
     }
 
     /// Total thermal energy of the body, Σ V_i ρc_i θ_i, J (relative to 0 °C).

@@ -47,13 +47,14 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         0.0,
         dt,
         &case.outputs,
-        |k, t, th| {
+        |k, t, th, conductance| {
             energy.push(model.energy(th));
             let path = field_path(out, k + 1);
-            let flux = model.conductance.flux(&model.cloud, th);
+            let flux = conductance.flux(&model.cloud, th);
+            let damage = model.damage_at(t);
             let f = Fields {
                 theta: th,
-                damage: &model.damage,
+                damage: &damage,
                 flux: &flux,
             };
             write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;

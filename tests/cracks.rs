@@ -266,13 +266,113 @@ fn crack_plate_matches_finite_differences() {
     eprintln!("crack plate: max |θ_PD − θ_FD| outside the tip discs = {worst:.3} °C");
     assert!(worst < 2.0, "max difference {worst} °C");
     let cl = &model.cloud;
+    let damage = model.damage_at(0.5);
     for i in 0..cl.n_body {
         let p = cl.pos[i];
-        let d = model.damage[i];
+        let d = damage[i];
         if p.y.abs() > delta + cl.spacing[i] || p.x.abs() > 0.005 + delta + cl.spacing[i] {
             assert_eq!(d, 0.0, "no crack within reach of {p:?}");
         } else if p.x.abs() < 0.004 && p.y.abs() < cl.spacing[i] {
             assert!(d > 0.3 && d < 0.6, "beside the crack {p:?}: damage {d}");
         }
     }
+}
+
+const GROWING: &str = r#"
+dimension = 2
+[domain]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[[region]]
+name = "r"
+spacing = 0.02
+horizon = { factor = 3 }
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[[crack]]
+points = [[0.0, 0.5003], [0.6, 0.5003], [1.0, 0.5003]]
+speed = 0.1
+start = 0.2
+initial_length = 0.1
+[initial]
+value = "y > 0.5"
+[time]
+end = 1.0
+integrator = "euler"
+"#;
+
+/// A growing crack cuts each pair when its tip passes the crossing point: at
+/// start + (x_cross − initial_length)/speed, pairs crossing the initial length at once,
+/// pairs the tip never reaches never. The stepper cuts them in place at that moment, K
+/// stays symmetric, and energy is conserved to round-off across the cuts.
+#[test]
+fn growing_crack_cuts_bonds_when_its_tip_passes() {
+    let model = Model::build(&case(GROWING).spec).unwrap();
+    let c = &model.cloud;
+    assert!(!model.growth.is_empty());
+    let k0 = &model.conductance;
+    let mut checked = 0;
+    for cut in &model.growth {
+        for (row, e) in cut.entries.into_iter().flatten() {
+            let (a, b) = (c.pos[row], c.pos[k0.cols[e] as usize]);
+            // where the bond crosses y = 0.5003
+            let x = a.x + (b.x - a.x) * (0.5003 - a.y) / (b.y - a.y);
+            let expected = 0.2 + (x - 0.1) / 0.1;
+            assert!(
+                (cut.time - expected).abs() < 1e-9,
+                "{a:?}-{b:?}: {} vs {expected}",
+                cut.time
+            );
+            assert!(x > 0.1);
+            checked += 1;
+        }
+    }
+    assert!(checked > 50);
+    // pairs crossing the initial length are cut from the start
+    let i = (0..c.n_body)
+        .find(|&i| (c.pos[i].x - 0.05).abs() < 1e-9 && (c.pos[i].y - 0.49).abs() < 1e-9)
+        .unwrap();
+    let j = (0..c.n_body)
+        .find(|&j| (c.pos[j].x - 0.05).abs() < 1e-9 && (c.pos[j].y - 0.51).abs() < 1e-9)
+        .unwrap();
+    assert_eq!(k0.get(i, j), 0.0);
+    // the pair at x = 0.41 is cut at 0.2 + 0.31/0.1 = 3.3 s: run past 0.5 s and check it is
+    // intact, then past 3.3 s and check it is cut
+    let i = (0..c.n_body)
+        .find(|&i| (c.pos[i].x - 0.41).abs() < 1e-9 && (c.pos[i].y - 0.49).abs() < 1e-9)
+        .unwrap();
+    let j = (0..c.n_body)
+        .find(|&j| (c.pos[j].x - 0.41).abs() < 1e-9 && (c.pos[j].y - 0.51).abs() < 1e-9)
+        .unwrap();
+    let intact = k0.get(i, j);
+    assert!(intact > 0.0);
+    let tc = model
+        .growth
+        .iter()
+        .find(|cut| {
+            cut.entries
+                .iter()
+                .flatten()
+                .any(|&(r, e)| r == i && k0.cols[e] as usize == j)
+        })
+        .unwrap()
+        .time;
+    assert!((tc - 3.3).abs() < 1e-9);
+    let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
+    let mut theta = model.theta0.clone();
+    let e0 = model.energy(&theta);
+    let mut st = Explicit::new(&model, Integrator::Euler);
+    let mut t = 0.0;
+    while t < 3.4 {
+        st.step(&mut theta, t, dt);
+        t += dt;
+        let now = st.conductance().get(i, j);
+        assert_eq!(now, if t - dt >= tc { 0.0 } else { intact }, "t = {t}");
+        assert_eq!(now, st.conductance().get(j, i));
+    }
+    let drift = (model.energy(&theta) - e0).abs() / e0.abs();
+    assert!(drift < 1e-12, "energy drift {drift:e}");
+    assert!(model.damage_at(3.4)[i] > model.damage_at(0.0)[i]);
 }

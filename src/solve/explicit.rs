@@ -6,8 +6,10 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::operator::Conductance;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// Explicit integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -87,8 +89,7 @@ pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
     n
 }
 
-fn rates(model: &Model, theta: &[f64], t: f64, out: &mut [f64]) {
-    let k = &model.conductance;
+fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64]) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
     out.par_iter_mut()
@@ -116,6 +117,10 @@ fn rates(model: &Model, theta: &[f64], t: f64, out: &mut [f64]) {
 /// Explicit integrator state with preallocated buffers.
 pub struct Explicit<'a> {
     model: &'a Model,
+    /// K as it is now: the model's, or an owned copy that growing cracks cut in place.
+    conductance: Cow<'a, Conductance>,
+    /// Index of the next growing-crack cut in `model.growth`.
+    next_cut: usize,
     integrator: Integrator,
     k: [Vec<f64>; 4],
     stage: Vec<f64>,
@@ -136,21 +141,50 @@ impl<'a> Explicit<'a> {
                 Vec::new()
             }
         });
+        let conductance = if model.growth.is_empty() {
+            Cow::Borrowed(&model.conductance)
+        } else {
+            Cow::Owned(model.conductance.clone())
+        };
         Explicit {
             model,
+            conductance,
+            next_cut: 0,
             integrator,
             k,
             stage: vec![0.0; model.cloud.len()],
         }
     }
 
-    /// Advances `theta` (all nodes) from t to t + h, constraints included.
+    /// K as it is now (growing cracks cut it as their tips pass), W/K.
+    pub fn conductance(&self) -> &Conductance {
+        &self.conductance
+    }
+
+    /// Cuts, in place, the pairs whose growing-crack cut time has come by `t`.
+    fn cut_until(&mut self, t: f64) {
+        let cuts = &self.model.growth;
+        while self.next_cut < cuts.len() && cuts[self.next_cut].time <= t {
+            let c = cuts[self.next_cut];
+            let k = self.conductance.to_mut();
+            for (row, e) in c.entries.into_iter().flatten() {
+                k.diag[row] -= k.vals[e] * (1.0 - c.mu);
+                k.vals[e] *= c.mu;
+            }
+            self.next_cut += 1;
+        }
+    }
+
+    /// Advances `theta` (all nodes) from t to t + h, constraints included; growing cracks
+    /// cut the bonds their tips have passed by t first.
     pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        self.cut_until(t);
         let m = self.model;
+        let k = &*self.conductance;
         let nb = m.cloud.n_body;
         match self.integrator {
             Integrator::Euler => {
-                rates(m, theta, t, &mut self.k[0]);
+                rates(m, k, theta, t, &mut self.k[0]);
                 theta[..nb]
                     .par_iter_mut()
                     .with_min_len(4096)
@@ -160,17 +194,17 @@ impl<'a> Explicit<'a> {
             Integrator::Rk4 => {
                 let [k1, k2, k3, k4] = &mut self.k;
                 let stage = &mut self.stage;
-                rates(m, theta, t, k1);
+                rates(m, k, theta, t, k1);
                 stage.copy_from_slice(theta);
                 axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k1);
                 m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
-                rates(m, stage, t + 0.5 * h, k2);
+                rates(m, k, stage, t + 0.5 * h, k2);
                 axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k2);
                 m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
-                rates(m, stage, t + 0.5 * h, k3);
+                rates(m, k, stage, t + 0.5 * h, k3);
                 axpy(&mut stage[..nb], &theta[..nb], h, k3);
                 m.boundary.apply(&m.cloud, stage, t + h);
-                rates(m, stage, t + h, k4);
+                rates(m, k, stage, t + h, k4);
                 let h6 = h / 6.0;
                 theta[..nb]
                     .par_iter_mut()
@@ -182,7 +216,7 @@ impl<'a> Explicit<'a> {
         m.boundary.apply(&m.cloud, theta, t + h);
     }
 
-    /// Integrates from `t0` through each output time, calling `on_output(k, t, θ)` there and
+    /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K)` there and
     /// `progress(steps)` now and then. Steps never exceed `dt` and land on the output times.
     pub fn run(
         &mut self,
@@ -190,7 +224,7 @@ impl<'a> Explicit<'a> {
         t0: f64,
         dt: f64,
         outputs: &[f64],
-        mut on_output: impl FnMut(usize, f64, &[f64]) -> Result<()>,
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
         mut progress: impl FnMut(u64),
     ) -> Result<RunStats> {
         let mut t = t0;
@@ -211,7 +245,8 @@ impl<'a> Explicit<'a> {
             }
             t = to;
             check_finite(theta, self.model.cloud.n_body, t)?;
-            on_output(k, t, theta)?;
+            self.cut_until(t);
+            on_output(k, t, theta, &self.conductance)?;
         }
         progress(stats.steps);
         Ok(stats)
