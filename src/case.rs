@@ -655,22 +655,43 @@ impl CaseFile {
                     CrackShape::Set(s)
                 }
                 (None, Some(pts)) => {
-                    if dim != 2 {
+                    if dim == 1 {
                         return Err(case_err(
                             path,
                             &key("points"),
-                            "polyline cracks are 2D; in 3D use a mesh group",
+                            "a 1D crack is a mesh point group",
                         ));
                     }
-                    if pts.len() < 2 {
-                        return Err(case_err(path, &key("points"), "needs at least two points"));
+                    let need = if dim == 2 { 2 } else { 3 };
+                    if pts.len() < need {
+                        return Err(case_err(
+                            path,
+                            &key("points"),
+                            format!("needs at least {need} points"),
+                        ));
                     }
                     let mut list = Vec::new();
                     for (k, p) in pts.iter().enumerate() {
                         let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
                         list.push(Point::new(q[0], q[1], q[2]));
                     }
-                    CrackShape::Polyline(list)
+                    if dim == 2 {
+                        CrackShape::Polyline(list)
+                    } else {
+                        let n = (list[1] - list[0]).cross(&(list[2] - list[0]));
+                        let size = (list[1] - list[0]).norm().max((list[2] - list[0]).norm());
+                        let planar = list
+                            .iter()
+                            .all(|p| (p - list[0]).dot(&n).abs() <= 1e-9 * n.norm() * size);
+                        if n.norm() <= 1e-12 * size * size || !planar {
+                            return Err(case_err(
+                                path,
+                                &key("points"),
+                                "a 3D crack is a planar polygon: its points must span one plane",
+                            ));
+                        }
+                        CrackShape::Polygon(list)
+                    }
                 }
                 _ => {
                     return Err(case_err(

@@ -50,6 +50,8 @@ pub enum CrackShape {
     Set(usize),
     /// A polyline through these points (2D), m.
     Polyline(Vec<Point>),
+    /// A planar polygon with these corners (3D), m; split into a fan of triangles.
+    Polygon(Vec<Point>),
 }
 
 /// A pre-crack (formulation §5).
@@ -98,6 +100,11 @@ pub fn crack_cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
                     out.extend(segments(&pairs, c.mu));
                 }
             },
+            CrackShape::Polygon(pts) => {
+                for w in pts[1..].windows(2) {
+                    out.extend(facet_cutters(&[pts[0], w[0], w[1]], c.mu, None));
+                }
+            }
             CrackShape::Set(s) => {
                 let Sides::Mesh(m) = &cloud.sides else {
                     continue;

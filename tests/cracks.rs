@@ -376,3 +376,47 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
     assert!(drift < 1e-12, "energy drift {drift:e}");
     assert!(model.damage_at(3.4)[i] > model.damage_at(0.0)[i]);
 }
+
+/// A 3D crack given as a planar polygon (a square in the plane z = 0.5 covering
+/// 0.2 ≤ x, y ≤ 0.6) cuts the bonds through it and no others: damage is positive next to it
+/// and zero beside it, and a node pair straddling it has K = 0.
+#[test]
+fn a_planar_polygon_cuts_3d_bonds() {
+    let text = r#"
+dimension = 3
+[domain]
+min = [0.0, 0.0, 0.0]
+max = [1.0, 1.0, 1.0]
+[[region]]
+name = "r"
+spacing = 0.1
+horizon = { factor = 2 }
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[[crack]]
+points = [[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]
+[time]
+end = 1.0
+"#;
+    let model = Model::build(&case(text).spec).unwrap();
+    let c = &model.cloud;
+    let find = |x: f64, y: f64, z: f64| {
+        (0..c.n_body)
+            .find(|&i| (c.pos[i] - peritherm::math::Point::new(x, y, z)).norm() < 1e-9)
+            .unwrap()
+    };
+    let (a, b) = (find(0.35, 0.45, 0.45), find(0.35, 0.45, 0.55));
+    assert_eq!(model.conductance.get(a, b), 0.0);
+    let (a2, b2) = (find(0.85, 0.45, 0.45), find(0.85, 0.45, 0.55));
+    assert!(model.conductance.get(a2, b2) > 0.0);
+    let d = model.damage_at(0.0);
+    assert!(d[a] > 0.2, "damage {}", d[a]);
+    assert_eq!(d[a2], 0.0);
+    let bad = text.replace("[0.2, 0.6, 0.5]]", "[0.2, 0.6, 0.7]]");
+    let e = Case::parse(&bad, &root().join("cases/test.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("crack[0].points") && e.contains("planar"), "{e}");
+}
