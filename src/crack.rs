@@ -290,6 +290,23 @@ pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The 2D crack segments present at time `t` (growing cracks up to their tips), m.
+pub fn segments_at(cutters: &[Cutter], t: f64) -> Vec<[Point; 2]> {
+    cutters
+        .iter()
+        .filter(|c| c.corners.len() == 2 && c.boundary.is_none())
+        .filter_map(|c| {
+            let (a, b) = (c.corners[0], c.corners[1]);
+            let Some(g) = c.growth else {
+                return Some([a, b]);
+            };
+            let covered = g.initial + g.speed * (t - g.start).max(0.0) - g.arc;
+            let len = (b - a).norm();
+            (covered > 0.0).then(|| [a, a + (b - a) * (covered / len).min(1.0)])
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

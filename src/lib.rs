@@ -25,6 +25,7 @@ pub mod model;
 pub mod neighbors;
 pub mod operator;
 pub mod output;
+pub mod plot;
 pub mod report;
 pub mod run;
 pub mod solve;

@@ -55,11 +55,25 @@ enum Command {
         /// Output directory of the reference run.
         reference: PathBuf,
     },
+    /// Draw a temperature map (PNG) of every output of a 2D run, cracks included, into the
+    /// run's directory as map_<k>.png.
+    Plot {
+        /// Output directory of `peritherm run`.
+        run: PathBuf,
+    },
     /// Validate a case and print its size and stable time step without running it.
     Check {
         /// The case file (TOML).
         case: PathBuf,
     },
+}
+
+/// Prints a line to stdout; a closed pipe (e.g. `| head`) ends the output quietly.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
 }
 
 fn main() -> ExitCode {
@@ -99,7 +113,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 bar.set_position(done);
             })?;
             bar.finish_and_clear();
-            println!(
+            say!(
                 "{}: {} nodes, {} bonds, {} steps of {:.3e} s in {:.2} s -> {}",
                 case.path.display(),
                 summary.nodes,
@@ -110,29 +124,33 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 out.display()
             );
             for c in &summary.reference {
-                println!(
+                say!(
                     "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
-                    c.time, c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line
+                    c.time,
+                    c.max_abs_diff,
+                    c.mean_sq_rel_diff,
+                    c.l2_rel_line
                 );
             }
             Ok(())
         }
         Command::Table { runs } => {
-            println!("{}", RunSummary::table_header());
+            say!("{}", RunSummary::table_header());
             for dir in runs {
                 for row in RunSummary::read(&dir)?.table_rows() {
-                    println!("{row}");
+                    say!("{row}");
                 }
             }
             Ok(())
         }
         Command::Compare { run, reference } => compare(&run, &reference),
+        Command::Plot { run } => plot(&run),
         Command::Check { case } => {
             let case = Case::load(&case)?;
             let model =
                 Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
             let bound = case.integrator.stable_dt(&model);
-            println!(
+            say!(
                 "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
                 case.path.display(),
                 model.cloud.n_body,
@@ -161,17 +179,22 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
         .bare_cloud()
         .with_context(|| case.path.display().to_string())?;
     let cracks = crack_cutters(&cloud, &case.spec.cracks);
-    println!("| run | nodes | bonds | steps | set-up (s) | wall (s) |");
-    println!("|---|---|---|---|---|---|");
+    say!("| run | nodes | bonds | steps | set-up (s) | wall (s) |");
+    say!("|---|---|---|---|---|---|");
     for s in [&a, &b] {
-        println!(
+        say!(
             "| {} | {} | {} | {} | {:.1} | {:.1} |",
-            s.case, s.nodes, s.bonds, s.steps, s.setup_seconds, s.wall_seconds
+            s.case,
+            s.nodes,
+            s.bonds,
+            s.steps,
+            s.setup_seconds,
+            s.wall_seconds
         );
     }
-    println!();
-    println!("| t (s) | max abs diff (°C) | mean abs diff (°C) | where (m) |");
-    println!("|---|---|---|---|");
+    say!();
+    say!("| t (s) | max abs diff (°C) | mean abs diff (°C) | where (m) |");
+    say!("|---|---|---|---|");
     for (k, t) in a.output_times.iter().enumerate() {
         let Some(kb) = b
             .output_times
@@ -182,10 +205,52 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
         };
         let fa = read_field(&run.join(&a.fields[k]))?;
         let fb = read_field(&reference.join(&b.fields[kb]))?;
-        let d = field_difference(cloud.dim, (&fa.0, &fa.1), (&fb.0, &fb.1), &cracks);
-        println!(
+        let d = field_difference(
+            cloud.dim,
+            (&fa.pos, &fa.theta),
+            (&fb.pos, &fb.theta),
+            &cracks,
+        );
+        say!(
             "| {t} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",
-            d.max_abs, d.mean_abs, d.at.x, d.at.y, d.at.z
+            d.max_abs,
+            d.mean_abs,
+            d.at.x,
+            d.at.y,
+            d.at.z
+        );
+    }
+    Ok(())
+}
+
+/// `peritherm plot`: one temperature map per output, on a colour range shared by all of them.
+fn plot(run: &std::path::Path) -> anyhow::Result<()> {
+    let summary = RunSummary::read(run)?;
+    let case = Case::load(std::path::Path::new(&summary.case))?;
+    if case.spec.geometry.bare_cloud()?.dim != 2 {
+        anyhow::bail!(
+            "{}: maps are drawn for 2D runs; open the field_<k>.vtu files in ParaView",
+            run.display()
+        );
+    }
+    let cloud = case.spec.geometry.bare_cloud()?;
+    let cutters = crack_cutters(&cloud, &case.spec.cracks);
+    let fields = summary
+        .fields
+        .iter()
+        .map(|f| read_field(&run.join(f)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (lo, hi) = fields
+        .iter()
+        .flat_map(|f| f.theta.iter())
+        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
+        let path = run.join(format!("map_{}.png", k + 1));
+        let cracks = peritherm::crack::segments_at(&cutters, *t);
+        peritherm::plot::temperature_map(&path, &f.pos, &f.theta, &f.spacing, (lo, hi), &cracks)?;
+        say!(
+            "t = {t} s: {} (blue {lo:.2} °C … white … red {hi:.2} °C)",
+            path.display()
         );
     }
     Ok(())

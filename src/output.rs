@@ -162,8 +162,18 @@ pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
     s
 }
 
-/// Reads the positions and temperatures of a `field_<k>.csv`.
-pub fn read_field(path: &Path) -> Result<(Vec<Point>, Vec<f64>)> {
+/// Node positions, temperatures and spacings read back from a `field_<k>.csv`.
+pub struct FieldRows {
+    /// Positions, m.
+    pub pos: Vec<Point>,
+    /// Temperatures, °C.
+    pub theta: Vec<f64>,
+    /// Spacings Δ, m.
+    pub spacing: Vec<f64>,
+}
+
+/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first).
+pub fn read_field(path: &Path) -> Result<FieldRows> {
     let bad = |m: String| Error::Io {
         path: path.to_path_buf(),
         error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
@@ -175,27 +185,32 @@ pub fn read_field(path: &Path) -> Result<(Vec<Point>, Vec<f64>)> {
     let mut lines = text.lines();
     if !lines
         .next()
-        .is_some_and(|h| h.starts_with("x,y,z,temperature"))
+        .is_some_and(|h| h.starts_with("x,y,z,temperature,region,spacing"))
     {
         return Err(bad(
-            "not a peritherm field file (header x,y,z,temperature,...)".into(),
+            "not a peritherm field file (header x,y,z,temperature,region,spacing,...)".into(),
         ));
     }
-    let (mut pos, mut theta) = (Vec::new(), Vec::new());
+    let mut rows = FieldRows {
+        pos: Vec::new(),
+        theta: Vec::new(),
+        spacing: Vec::new(),
+    };
     for (k, line) in lines.enumerate() {
         let v: Vec<f64> = line
             .split(',')
-            .take(4)
+            .take(6)
             .map(str::parse)
             .collect::<std::result::Result<_, _>>()
             .map_err(|e| bad(format!("line {}: {e}", k + 2)))?;
-        if v.len() < 4 {
-            return Err(bad(format!("line {}: fewer than 4 columns", k + 2)));
+        if v.len() < 6 {
+            return Err(bad(format!("line {}: fewer than 6 columns", k + 2)));
         }
-        pos.push(Point::new(v[0], v[1], v[2]));
-        theta.push(v[3]);
+        rows.pos.push(Point::new(v[0], v[1], v[2]));
+        rows.theta.push(v[3]);
+        rows.spacing.push(v[5]);
     }
-    Ok((pos, theta))
+    Ok(rows)
 }
 
 /// Comparison with a classical solution at one output time (formulation §9).

@@ -246,7 +246,8 @@ fn crack_plate_matches_finite_differences() {
     let out = tempfile::tempdir().unwrap();
     peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
     let model = Model::build(&c.spec).unwrap();
-    let (pos, theta) = peritherm::output::read_field(&out.path().join("field_1.csv")).unwrap();
+    let rows = peritherm::output::read_field(&out.path().join("field_1.csv")).unwrap();
+    let (pos, theta) = (rows.pos, rows.theta);
     let n = 360;
     let fd = fd_crack_plate(n, 0.01, 0.005);
     let h = 0.02 / n as f64;
