@@ -204,6 +204,9 @@ pub struct KernelSpec {
     /// Symmetric correction of K that makes linear fields exact at horizon changes.
     #[serde(default)]
     pub linear_consistency: bool,
+    /// Restore the horizon's second moment at nodes whose bonds a pre-crack cuts.
+    #[serde(default)]
+    pub crack_correction: bool,
 }
 
 fn default_p() -> u8 {
@@ -225,6 +228,7 @@ impl Default for KernelSpec {
             bond_rule: BondRule::default(),
             calibration: Calibration::default(),
             linear_consistency: false,
+            crack_correction: false,
         }
     }
 }
@@ -1077,6 +1081,7 @@ impl CaseFile {
                 source,
                 initial,
                 linear_consistency: self.kernel.linear_consistency,
+                crack_correction: self.kernel.crack_correction,
             },
             integrator: self.time.integrator,
             dt: self.time.dt,

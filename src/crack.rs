@@ -268,6 +268,45 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> C
     Cuts { mu, later }
 }
 
+/// Skin correction at cracks (beyond the papers): a node whose bonds a crack cuts loses
+/// part of its horizon's second moment Σ_j w_ij |ξ_ij|², so the conductivity along the crack
+/// face drops (the skin effect seed 003 accepts). This scales the node's own directed
+/// weights by the moment of all its bonds over the moment of the bonds the crack leaves
+/// (`mu` = the cracks' μ per directed bond), restoring the moment; K stays symmetric since
+/// K_ij = V_i V_j (w_ij + w_ji).
+pub fn restore_moment(cloud: &Cloud, horizons: &Horizons, mu: &[f64], weights: &mut [f64]) {
+    if mu.is_empty() {
+        return;
+    }
+    let mut rows: Vec<(usize, &mut [f64])> = Vec::with_capacity(horizons.len());
+    let mut rest = weights;
+    for i in 0..horizons.len() {
+        let (a, b) = rest.split_at_mut(horizons.row(i).len());
+        rows.push((i, a));
+        rest = b;
+    }
+    rows.into_par_iter()
+        .with_min_len(256)
+        .for_each(|(i, slot)| {
+            let range = horizons.row(i);
+            if range.clone().all(|b| mu[b] == 1.0) {
+                return;
+            }
+            let (mut all, mut kept) = (0.0, 0.0);
+            for (w, b) in slot.iter().zip(range.clone()) {
+                let r2 = (cloud.pos[horizons.targets[b] as usize] - cloud.pos[i]).norm_squared();
+                all += w * r2;
+                kept += w * r2 * mu[b];
+            }
+            if kept > 0.0 {
+                let f = all / kept;
+                for w in slot.iter_mut() {
+                    *w *= f;
+                }
+            }
+        });
+}
+
 /// Damage of every body node (formulation §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
 /// the directed bonds of i (0 intact, 1 with every bond cut).
 pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {

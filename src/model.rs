@@ -86,6 +86,9 @@ pub struct ModelSpec {
     pub initial: Initial,
     /// Correct K so that linear fields are exact at horizon changes ([`crate::consistency`]).
     pub linear_consistency: bool,
+    /// Restore, at nodes whose bonds a pre-crack cuts, the second moment of their horizon
+    /// ([`crate::crack::restore_moment`]).
+    pub crack_correction: bool,
 }
 
 /// Cutting facets of the cracks (formulation §5).
@@ -273,6 +276,9 @@ impl Model {
         } else {
             bond_factors(&cloud, &horizons, &crack_cutters(&cloud, &spec.cracks))
         };
+        if spec.crack_correction {
+            crate::crack::restore_moment(&cloud, &horizons, &crack_cuts.mu, &mut weights);
+        }
         for (w, m) in weights.iter_mut().zip(mu) {
             *w *= m;
         }

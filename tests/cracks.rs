@@ -140,11 +140,13 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
     }
 }
 
-/// Steady temperature of the seed 003 Example 3 plate by finite differences: n × n cells on
+/// Temperature of the seed 003 Example 3 plate by finite differences: n × n cells on
 /// [−a, a]², 5-point stencil, the crack as removed face conductances between the rows on
 /// either side of y = 0 for |x| < c, held top and bottom faces (±100 °C), insulated sides.
-/// Solved by Jacobi-preconditioned conjugate gradients to 1e-12 relative residual.
-fn fd_crack_plate(n: usize, a: f64, c: f64) -> Vec<f64> {
+/// `transient = Some((α, Δt, steps))` takes backward Euler steps from θ0 = 0; None solves the
+/// steady state. Each system is solved by Jacobi-preconditioned conjugate gradients to 1e-10
+/// relative residual (an independent classical solver).
+fn fd_crack_plate(n: usize, a: f64, c: f64, transient: Option<(f64, f64, usize)>) -> Vec<f64> {
     let h = 2.0 * a / n as f64;
     let id = |i: usize, j: usize| j * n + i;
     let x = |i: usize| -a + (i as f64 + 0.5) * h;
@@ -156,11 +158,16 @@ fn fd_crack_plate(n: usize, a: f64, c: f64) -> Vec<f64> {
             1.0
         }
     };
+    // shift = h²/(α Δt): the system of one step is (shift I + A) θ_new = shift θ_old + b
+    let (shift, steps) = match transient {
+        Some((alpha, dt, steps)) => (h * h / (alpha * dt), steps),
+        None => (0.0, 1),
+    };
     let apply = |t: &[f64], out: &mut [f64]| {
         for j in 0..n {
             for i in 0..n {
                 let k = id(i, j);
-                let mut s = 0.0;
+                let mut s = shift * t[k];
                 if i > 0 {
                     s += t[k] - t[id(i - 1, j)];
                 }
@@ -185,8 +192,7 @@ fn fd_crack_plate(n: usize, a: f64, c: f64) -> Vec<f64> {
     for j in 0..n {
         for i in 0..n {
             let k = id(i, j);
-            let mut d = 0.0;
-            d += (i > 0) as u8 as f64 + (i + 1 < n) as u8 as f64;
+            let mut d = shift + (i > 0) as u8 as f64 + (i + 1 < n) as u8 as f64;
             if j > 0 {
                 d += vertical(i, j - 1);
             }
@@ -204,52 +210,61 @@ fn fd_crack_plate(n: usize, a: f64, c: f64) -> Vec<f64> {
             diag[k] = d;
         }
     }
-    let mut t = vec![0.0; n * n];
-    let mut r = b.clone();
-    let mut z: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
-    let mut p = z.clone();
-    let mut ap = vec![0.0; n * n];
     let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
-    let mut rz = dot(&r, &z);
-    let b_norm = dot(&b, &b).sqrt();
-    for _ in 0..20 * n {
-        apply(&p, &mut ap);
-        let alpha = rz / dot(&p, &ap);
+    let mut t = vec![0.0; n * n];
+    let (mut ap, mut rhs) = (vec![0.0; n * n], vec![0.0; n * n]);
+    for _ in 0..steps {
         for k in 0..n * n {
-            t[k] += alpha * p[k];
-            r[k] -= alpha * ap[k];
+            rhs[k] = shift * t[k] + b[k];
         }
-        if dot(&r, &r).sqrt() < 1e-12 * b_norm {
-            break;
-        }
-        for k in 0..n * n {
-            z[k] = r[k] / diag[k];
-        }
-        let rz_new = dot(&r, &z);
-        let beta = rz_new / rz;
-        rz = rz_new;
-        for k in 0..n * n {
-            p[k] = z[k] + beta * p[k];
+        apply(&t, &mut ap);
+        let mut r: Vec<f64> = rhs.iter().zip(&ap).map(|(f, a)| f - a).collect();
+        let mut z: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
+        let mut p = z.clone();
+        let mut rz = dot(&r, &z);
+        let norm = dot(&rhs, &rhs).sqrt();
+        for _ in 0..20 * n {
+            if dot(&r, &r).sqrt() < 1e-10 * norm {
+                break;
+            }
+            apply(&p, &mut ap);
+            let step = rz / dot(&p, &ap);
+            for k in 0..n * n {
+                t[k] += step * p[k];
+                r[k] -= step * ap[k];
+            }
+            for k in 0..n * n {
+                z[k] = r[k] / diag[k];
+            }
+            let rz_new = dot(&r, &z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for k in 0..n * n {
+                p[k] = z[k] + beta * p[k];
+            }
         }
     }
     t
 }
 
-/// The bundled seed 003 Example 3 crack plate at 0.5 s agrees with the classical steady
-/// solution (fine finite differences, 3 cells per PD node so that every node sits on a cell
-/// centre) within 2 °C at every node outside the 2δ discs around the crack tips; the flux is
+/// The bundled seed 003 Example 3 crack plate (with the crack correction), run on to its
+/// steady state (3 s), agrees with the classical steady solution (finite differences, 3 × 3
+/// cells per PD node so that every node sits on a cell centre) within 1 °C at every node
+/// outside the 2δ discs around the crack tips. Measured 0.48 °C, the PD discretisation at
+/// δ = 13L/240 (without the crack correction: 2.22 °C, beside the crack faces). The flux is
 /// finite everywhere, damage is 0 far from the crack and positive beside it.
 #[test]
 fn crack_plate_matches_finite_differences() {
     let mut c = Case::load(&root().join("cases/crack_plate.toml")).unwrap();
-    c.outputs = vec![0.5];
+    c.outputs = vec![3.0];
+    c.end = 3.0;
     let out = tempfile::tempdir().unwrap();
     peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
     let model = Model::build(&c.spec).unwrap();
     let rows = peritherm::output::read_field(&out.path().join("field_1.csv")).unwrap();
     let (pos, theta) = (rows.pos, rows.theta);
     let n = 360;
-    let fd = fd_crack_plate(n, 0.01, 0.005);
+    let fd = fd_crack_plate(n, 0.01, 0.005, None);
     let h = 0.02 / n as f64;
     let delta = 13.0 * 0.02 / 240.0;
     let mut worst: f64 = 0.0;
@@ -265,7 +280,7 @@ fn crack_plate_matches_finite_differences() {
         worst = worst.max((t - fd[j * n + i]).abs());
     }
     eprintln!("crack plate: max |θ_PD − θ_FD| outside the tip discs = {worst:.3} °C");
-    assert!(worst < 2.0, "max difference {worst} °C");
+    assert!(worst < 1.0, "max difference {worst} °C");
     // the heat flux (columns qx, qy) is finite everywhere and at the tips a few times the
     // far-field flux k·200 °C/2 cm = 1.14e6 W/m² (measured: 3.9e6 at the node by the tip)
     let text = std::fs::read_to_string(out.path().join("field_1.csv")).unwrap();
@@ -283,7 +298,7 @@ fn crack_plate_matches_finite_differences() {
         "flux at the tips {tip_flux:e} W/m²"
     );
     let cl = &model.cloud;
-    let damage = model.damage_at(0.5);
+    let damage = model.damage_at(3.0);
     for i in 0..cl.n_body {
         let p = cl.pos[i];
         let d = damage[i];
