@@ -208,14 +208,8 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> C
             Fictitious::Lattice { .. } => true,
         }
     };
-    let mut rows: Vec<(usize, &mut [f64])> = Vec::with_capacity(horizons.len());
-    let mut rest = mu.as_mut_slice();
-    for i in 0..horizons.len() {
-        let (a, b) = rest.split_at_mut(horizons.row(i).len());
-        rows.push((i, a));
-        rest = b;
-    }
-    let later: Vec<(usize, f64, f64)> = rows
+    let later: Vec<(usize, f64, f64)> = horizons
+        .rows_mut(&mut mu)
         .into_par_iter()
         .with_min_len(64)
         .flat_map_iter(|(i, slot)| {
@@ -278,14 +272,9 @@ pub fn restore_moment(cloud: &Cloud, horizons: &Horizons, mu: &[f64], weights: &
     if mu.is_empty() {
         return;
     }
-    let mut rows: Vec<(usize, &mut [f64])> = Vec::with_capacity(horizons.len());
-    let mut rest = weights;
-    for i in 0..horizons.len() {
-        let (a, b) = rest.split_at_mut(horizons.row(i).len());
-        rows.push((i, a));
-        rest = b;
-    }
-    rows.into_par_iter()
+    horizons
+        .rows_mut(weights)
+        .into_par_iter()
         .with_min_len(256)
         .for_each(|(i, slot)| {
             let range = horizons.row(i);

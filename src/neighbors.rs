@@ -100,6 +100,19 @@ impl Horizons {
         self.targets.len()
     }
 
+    /// Splits a per-bond array into one mutable slice per row, tagged with the row index,
+    /// so that rows can be filled in parallel (gather form: each row writes only its own).
+    pub fn rows_mut<'a, T>(&self, per_bond: &'a mut [T]) -> Vec<(usize, &'a mut [T])> {
+        let mut out = Vec::with_capacity(self.len());
+        let mut rest = per_bond;
+        for i in 0..self.len() {
+            let (a, b) = rest.split_at_mut(self.row(i).len());
+            out.push((i, a));
+            rest = b;
+        }
+        out
+    }
+
     /// Range of bond indices of row i.
     pub fn row(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i]..self.offsets[i + 1]

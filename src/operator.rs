@@ -34,17 +34,8 @@ pub fn directed_weights(
 ) -> Vec<f64> {
     let mut w = vec![0.0; horizons.n_bonds()];
     let units = unit_normalisations(cloud, kernel);
-    let chunks: Vec<(usize, &mut [f64])> = {
-        let mut out = Vec::with_capacity(horizons.len());
-        let mut rest = w.as_mut_slice();
-        for i in 0..horizons.len() {
-            let (a, b) = rest.split_at_mut(horizons.row(i).len());
-            out.push((i, a));
-            rest = b;
-        }
-        out
-    };
-    chunks
+    horizons
+        .rows_mut(&mut w)
         .into_par_iter()
         .with_min_len(256)
         .for_each(|(i, slot)| {

@@ -15,6 +15,15 @@ fn case(text: &str) -> Case {
     Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The body node at (x, y, z) (within 1e-9 m).
+fn node_at(model: &Model, x: f64, y: f64, z: f64) -> usize {
+    let c = &model.cloud;
+    let p = peritherm::math::Point::new(x, y, z);
+    (0..c.n_body)
+        .find(|&i| (c.pos[i] - p).norm() < 1e-9)
+        .unwrap_or_else(|| panic!("no node at {p:?}"))
+}
+
 fn run_steps(model: &Model, steps: usize, dt: f64) -> Vec<f64> {
     let mut theta = model.theta0.clone();
     let mut st = Explicit::new(model, Integrator::Euler);
@@ -368,21 +377,17 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
     }
     assert!(checked > 50);
     // pairs crossing the initial length are cut from the start
-    let i = (0..c.n_body)
-        .find(|&i| (c.pos[i].x - 0.05).abs() < 1e-9 && (c.pos[i].y - 0.49).abs() < 1e-9)
-        .unwrap();
-    let j = (0..c.n_body)
-        .find(|&j| (c.pos[j].x - 0.05).abs() < 1e-9 && (c.pos[j].y - 0.51).abs() < 1e-9)
-        .unwrap();
+    let (i, j) = (
+        node_at(&model, 0.05, 0.49, 0.0),
+        node_at(&model, 0.05, 0.51, 0.0),
+    );
     assert_eq!(k0.get(i, j), 0.0);
     // the pair at x = 0.41 is cut at 0.2 + 0.31/0.1 = 3.3 s: run past 0.5 s and check it is
     // intact, then past 3.3 s and check it is cut
-    let i = (0..c.n_body)
-        .find(|&i| (c.pos[i].x - 0.41).abs() < 1e-9 && (c.pos[i].y - 0.49).abs() < 1e-9)
-        .unwrap();
-    let j = (0..c.n_body)
-        .find(|&j| (c.pos[j].x - 0.41).abs() < 1e-9 && (c.pos[j].y - 0.51).abs() < 1e-9)
-        .unwrap();
+    let (i, j) = (
+        node_at(&model, 0.41, 0.49, 0.0),
+        node_at(&model, 0.41, 0.51, 0.0),
+    );
     let intact = k0.get(i, j);
     assert!(intact > 0.0);
     let tc = model
@@ -438,12 +443,7 @@ points = [[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]
 end = 1.0
 "#;
     let model = Model::build(&case(text).spec).unwrap();
-    let c = &model.cloud;
-    let find = |x: f64, y: f64, z: f64| {
-        (0..c.n_body)
-            .find(|&i| (c.pos[i] - peritherm::math::Point::new(x, y, z)).norm() < 1e-9)
-            .unwrap()
-    };
+    let find = |x: f64, y: f64, z: f64| node_at(&model, x, y, z);
     let (a, b) = (find(0.35, 0.45, 0.45), find(0.35, 0.45, 0.55));
     assert_eq!(model.conductance.get(a, b), 0.0);
     let (a2, b2) = (find(0.85, 0.45, 0.45), find(0.85, 0.45, 0.55));
