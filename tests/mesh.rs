@@ -258,18 +258,24 @@ end = 1.0
     );
 }
 
+/// Runs the bundled case `name` to time `t` and returns its largest difference from the
+/// case's classical reference there, °C.
+fn max_diff_at(name: &str, t: f64) -> f64 {
+    let mut c = Case::load(&root().join(format!("cases/{name}.toml"))).unwrap();
+    c.outputs = vec![t];
+    c.end = t;
+    let out = tempfile::tempdir().unwrap();
+    let s = peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
+    s.reference[0].max_abs_diff
+}
+
 /// Fictitious layers mirrored across curved (chord) boundaries: the ring held at 100 °C
 /// inside and 0 °C outside reaches the logarithmic steady profile. Measured 0.11 °C; the
 /// tolerance 0.25 °C (0.25 % of the span) covers the chords of 2.5e-4 m standing in for the
 /// circles and the quadrature of triangles.
 #[test]
 fn annulus_reaches_the_logarithmic_profile() {
-    let mut c = Case::load(&root().join("cases/annulus_steady.toml")).unwrap();
-    c.outputs = vec![1e-4];
-    c.end = 1e-4;
-    let out = tempfile::tempdir().unwrap();
-    let s = peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
-    let max = s.reference[0].max_abs_diff;
+    let max = max_diff_at("annulus_steady", 1e-4);
     assert!(max < 0.25, "max |θ − θ_c| = {max}");
 }
 
@@ -279,12 +285,7 @@ fn annulus_reaches_the_logarithmic_profile() {
 /// the sub-block, where no consistency correction is possible (it would need negative K).
 #[test]
 fn refined_block_follows_the_slab_series() {
-    let mut c = Case::load(&root().join("cases/block_refined.toml")).unwrap();
-    c.outputs = vec![1.0];
-    c.end = 1.0;
-    let out = tempfile::tempdir().unwrap();
-    let s = peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
-    let max = s.reference[0].max_abs_diff;
+    let max = max_diff_at("block_refined", 1.0);
     assert!(max < 2.0, "max |θ − θ_c| = {max}");
 }
 
