@@ -253,6 +253,9 @@ pub struct RunSummary {
     pub title: String,
     /// Case file.
     pub case: String,
+    /// Solver that wrote the run: `peridynamics` or `fem` (run.json files without it: peridynamics).
+    #[serde(default = "peridynamics")]
+    pub solver: String,
     /// Body nodes.
     pub nodes: usize,
     /// Fictitious nodes.
@@ -293,6 +296,10 @@ pub struct RunSummary {
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,
+}
+
+fn peridynamics() -> String {
+    "peridynamics".into()
 }
 
 impl RunSummary {

@@ -91,6 +91,7 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let summary = RunSummary {
         title: case.title.clone(),
         case: case.path.display().to_string(),
+        solver: "peridynamics".into(),
         nodes: model.cloud.n_body,
         fictitious_nodes: model.cloud.n_fictitious(),
         bonds: model.horizons.n_bonds(),
