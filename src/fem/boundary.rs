@@ -53,6 +53,8 @@ pub struct Conditions {
     varying: Vec<Load>,
     /// Sum of the loads that do not depend on t, W.
     fixed: Vec<f64>,
+    /// True when some set has a convection condition.
+    convective: bool,
 }
 
 fn facet_points(mesh: &FemMesh, f: FacetRef) -> Vec<QPoint> {
@@ -125,6 +127,7 @@ impl Conditions {
             values: Vec::new(),
             varying: Vec::new(),
             fixed: vec![0.0; nn],
+            convective: false,
         };
         let mut loads = Vec::new();
         for (s, bc) in faces.iter().enumerate() {
@@ -148,6 +151,7 @@ impl Conditions {
                     points: set.iter().flat_map(|&f| facet_points(mesh, f)).collect(),
                 }),
                 FaceBc::Convection { h, ambient } => {
+                    c.convective |= !set.is_empty();
                     let points: Vec<QPoint> =
                         set.iter().flat_map(|&f| facet_points(mesh, f)).collect();
                     for q in &points {
@@ -207,6 +211,12 @@ impl Conditions {
                 theta[i] = self.values[k as usize].eval(p.x, p.y, p.z, t);
             }
         }
+    }
+
+    /// True when the temperature is anchored (a held node or a convection boundary), i.e. the
+    /// steady problem has a unique solution.
+    pub fn anchored(&self) -> bool {
+        self.convective || self.held.iter().any(|&k| k != u32::MAX)
     }
 
     /// True when some load or held value depends on t.

@@ -9,6 +9,7 @@ use crate::cloud::mesh::MeshGeometry;
 use crate::error::{Error, Result};
 use crate::math::Point;
 use crate::mesh::ElementKind;
+use crate::spatial::PointIndex;
 use std::collections::HashMap;
 
 /// One cell: its kind, node indices (the first `kind.n_nodes()` are used), region and material.
@@ -168,6 +169,65 @@ impl FemMesh {
             m.sets.push(set);
         }
         Ok(m)
+    }
+
+    /// An error when a node lies inside a boundary facet of another cell (a hanging node:
+    /// regions meshed with different sizes that do not share their interface nodes). Probes
+    /// the centre of every facet that belongs to one cell only, and in 3D its edge midpoints.
+    pub fn check_conforming(&self) -> Result<()> {
+        let map = self.facet_map();
+        let boundary: Vec<FacetRef> = map
+            .values()
+            .filter(|v| v.len() == 1)
+            .map(|v| v[0])
+            .collect();
+        let mut on_boundary = vec![false; self.nodes.len()];
+        for &f in &boundary {
+            for n in self.facet_nodes(f) {
+                on_boundary[n as usize] = true;
+            }
+        }
+        let ids: Vec<usize> = (0..self.nodes.len()).filter(|&i| on_boundary[i]).collect();
+        let pts: Vec<Point> = ids.iter().map(|&i| self.nodes[i]).collect();
+        let index = PointIndex::new(&pts);
+        for &f in &boundary {
+            let nodes: Vec<u32> = self.facet_nodes(f).collect();
+            let corners: Vec<Point> = nodes.iter().map(|&n| self.nodes[n as usize]).collect();
+            let size = corners
+                .iter()
+                .map(|p| (p - corners[0]).norm())
+                .fold(0.0, f64::max);
+            let mut probes = vec![Point::from(
+                corners
+                    .iter()
+                    .map(|p| p.coords)
+                    .sum::<crate::math::Vector>()
+                    / corners.len() as f64,
+            )];
+            if corners.len() > 2 {
+                for k in 0..corners.len() {
+                    let (a, b) = (corners[k], corners[(k + 1) % corners.len()]);
+                    probes.push(Point::from((a.coords + b.coords) * 0.5));
+                }
+            }
+            for p in probes {
+                if let Some(&j) = index
+                    .within(&p, 1e-6 * size)
+                    .iter()
+                    .find(|&&j| !nodes.contains(&(ids[j] as u32)))
+                {
+                    let q = pts[j];
+                    return Err(Error::model(
+                        "mesh",
+                        format!(
+                            "fem: the mesh is not conforming: node ({:e}, {:e}, {:e}) lies inside an element side it does not belong to (regions meshed with different sizes that do not share their interface nodes); the FEM reference needs a conforming mesh",
+                            q.x, q.y, q.z
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Facet keys of the gmsh boundary set `s` (e.g. a crack group), in this mesh's numbering.

@@ -7,7 +7,7 @@ use super::field::{output_cloud, Recovery};
 use super::grid::box_mesh;
 use super::mesh::FemMesh;
 use super::solve::{Scheme, Stepper};
-use super::split::{crack_facets, split};
+use super::split::{check_cracks, crack_facets, split};
 use crate::case::Case;
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
@@ -49,6 +49,7 @@ pub fn default_dt(case: &Case) -> f64 {
 /// The FEM mesh of a case (split along its cracks) and the number of nodes the split added.
 pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
     let spec = &case.spec;
+    check_cracks(&spec.cracks)?;
     let mut mesh = match &spec.geometry {
         Geometry::Box(g) => {
             let finest = g
@@ -65,7 +66,9 @@ pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
                     "fem: applies to the built-in box geometry; a gmsh case is solved on its own mesh",
                 ));
             }
-            FemMesh::from_gmsh(g)?
+            let m = FemMesh::from_gmsh(g)?;
+            m.check_conforming()?;
+            m
         }
     };
     let keys = crack_facets(&mesh, &spec.cracks)?;

@@ -109,6 +109,12 @@ impl<'a> Stepper<'a> {
         {
             return Ok(k);
         }
+        if dt == 0.0 && !self.cond.anchored() {
+            return Err(Error::model(
+                "boundary",
+                "fem: the steady temperature is not determined (the system matrix is not positive definite): give a held temperature or a convection boundary",
+            ));
+        }
         let (sys, w) = (self.sys, self.scheme.weight());
         let inv_dt = if dt > 0.0 { 1.0 / dt } else { 0.0 };
         let mut trip = Vec::with_capacity(sys.cols.len() / 2 + self.free.len());

@@ -98,14 +98,8 @@ fn clipped_length(a: &Point, b: &Point, lo: &Point, hi: &Point) -> f64 {
     (t1 - t0).max(0.0) * d.norm()
 }
 
-/// Facet keys of every crack; errors for what the FEM solver does not represent (partly
-/// conducting, growing, or not along element facets).
-pub fn crack_facets(mesh: &FemMesh, cracks: &[Crack]) -> Result<Vec<FacetKey>> {
-    let mut keys = Vec::new();
-    if cracks.is_empty() {
-        return Ok(keys);
-    }
-    let map = mesh.facet_map();
+/// Checks that every crack is one the FEM solver represents: standing and insulated.
+pub fn check_cracks(cracks: &[Crack]) -> Result<()> {
     for (k, c) in cracks.iter().enumerate() {
         if c.growth.is_some() {
             return Err(Error::model(
@@ -119,6 +113,19 @@ pub fn crack_facets(mesh: &FemMesh, cracks: &[Crack]) -> Result<Vec<FacetKey>> {
                 format!("fem: partially conducting cracks are not supported (conductance = {}); only insulated cracks (0)", c.mu),
             ));
         }
+    }
+    Ok(())
+}
+
+/// Facet keys of every crack (see [`check_cracks`] first); an error when a polyline crack
+/// does not follow element facets.
+pub fn crack_facets(mesh: &FemMesh, cracks: &[Crack]) -> Result<Vec<FacetKey>> {
+    let mut keys = Vec::new();
+    if cracks.is_empty() {
+        return Ok(keys);
+    }
+    let map = mesh.facet_map();
+    for (k, c) in cracks.iter().enumerate() {
         match &c.shape {
             CrackShape::Set(s) => keys.extend(mesh.set_keys(*s)),
             CrackShape::Polyline(pts) if mesh.dim == 2 => {
