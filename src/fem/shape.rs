@@ -183,10 +183,10 @@ pub fn physical(
     let det = j.determinant();
     let inv = j.try_inverse().unwrap_or_else(nalgebra::Matrix3::zeros);
     let mut g = [[0.0; 3]; MAX_NODES];
-    for a in 0..n {
+    for (ga, dn) in g.iter_mut().zip(&s.dn).take(n) {
         // ∇N = J^{-T} ∂N/∂ξ
-        for r in 0..dim {
-            g[a][r] = (0..dim).map(|c| inv[(c, r)] * s.dn[a][c]).sum();
+        for (r, v) in ga.iter_mut().enumerate().take(dim) {
+            *v = (0..dim).map(|c| inv[(c, r)] * dn[c]).sum();
         }
     }
     (g, det.abs())

@@ -10,9 +10,66 @@ use super::assemble::System;
 use super::boundary::Conditions;
 use super::mesh::FemMesh;
 use crate::error::{Error, Result};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMat, Triplet};
+use faer::{Conj, Side};
+
+/// A sparse Cholesky factor L Lᵀ with the scratch memory its solves need, so that solving
+/// allocates nothing.
+struct Factor {
+    /// Δt it was made for, s (0: the steady matrix K).
+    dt: f64,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    scratch: MemBuffer,
+}
+
+impl Factor {
+    /// Factorises the lower triangle `a` (SPD), or says why it cannot.
+    fn new(dt: f64, a: &SparseColMat<usize, f64>) -> std::result::Result<Factor, String> {
+        let par = faer::get_global_parallelism();
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .map_err(|e| format!("{e:?}"))?;
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut work =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                a.as_ref(),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut work),
+                Default::default(),
+            )
+            .map_err(|e| e.to_string())?;
+        let scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+        Ok(Factor {
+            dt,
+            symbolic,
+            values,
+            scratch,
+        })
+    }
+
+    /// Overwrites `rhs` with the solution of L Lᵀ x = rhs.
+    fn solve(&mut self, rhs: &mut [f64]) {
+        let n = rhs.len();
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
+            faer::get_global_parallelism(),
+            MemStack::new(&mut self.scratch),
+        );
+    }
+}
 
 /// Time discretisation of the FEM solver.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,7 +112,7 @@ pub struct Stepper<'a> {
     /// Node of each reduced index.
     free: Vec<u32>,
     /// Factorisations by Δt (s); the steady one under Δt = 0.
-    factors: Vec<(f64, Llt<usize, f64>)>,
+    factors: Vec<Factor>,
     f_now: Vec<f64>,
     f_next: Vec<f64>,
     f_time: f64,
@@ -105,7 +162,7 @@ impl<'a> Stepper<'a> {
         if let Some(k) = self
             .factors
             .iter()
-            .position(|(d, _)| (d - dt).abs() <= 1e-12 * dt.abs())
+            .position(|f| (f.dt - dt).abs() <= 1e-12 * dt.abs())
         {
             return Ok(k);
         }
@@ -137,10 +194,7 @@ impl<'a> Stepper<'a> {
         };
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &trip)
             .map_err(|e| not_spd(format!("{e:?}")))?;
-        let llt = a
-            .sp_cholesky(faer::Side::Lower)
-            .map_err(|e| not_spd(e.to_string()))?;
-        self.factors.push((dt, llt));
+        self.factors.push(Factor::new(dt, &a).map_err(not_spd)?);
         Ok(self.factors.len() - 1)
     }
 
@@ -148,8 +202,7 @@ impl<'a> Stepper<'a> {
     fn solve_into(&mut self, k: usize, theta: &mut [f64], t: f64) -> Result<()> {
         let nf = self.free.len();
         if nf > 0 {
-            let rhs = faer::MatMut::from_column_major_slice_mut(&mut self.rhs, nf, 1);
-            self.factors[k].1.solve_in_place(rhs);
+            self.factors[k].solve(&mut self.rhs);
         }
         for (r, &i) in self.free.iter().enumerate() {
             let v = self.rhs[r];
