@@ -6,6 +6,10 @@
 //! `volume` = lumped nodal measure ∫N_i dV, `damage` = 0, `region` = the region of the first
 //! cell around it, and q = −k∇θ taken at the centre of every cell around the node and averaged
 //! with the cells' measures as weights, W/m².
+//!
+//! The copies of a node split along a crack share a position; each is written 1e-9 × its
+//! spacing off it, towards the centre of the cells it belongs to, so that readers that tell
+//! the crack's sides apart by position (`peritherm compare`, `plot`) put it on its own side.
 
 use super::assemble::System;
 use super::mesh::FemMesh;
@@ -67,6 +71,32 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
             material[i] = mesh.cells[e as usize].material;
         }
     }
+    let mut pos = mesh.nodes.clone();
+    let mut at: std::collections::HashMap<[u64; 3], Vec<usize>> = Default::default();
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        at.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+            .or_default()
+            .push(i);
+    }
+    for group in at.values().filter(|g| g.len() > 1) {
+        for &i in group {
+            let ring = &cells[offsets[i]..offsets[i + 1]];
+            let mut c = Vector::zeros();
+            for &(e, _) in ring {
+                let cell = &mesh.cells[e as usize];
+                let corners = mesh.corners(cell);
+                c += corners[..cell.kind.n_nodes()]
+                    .iter()
+                    .map(|q| q.coords)
+                    .sum::<Vector>()
+                    / cell.kind.n_nodes() as f64;
+            }
+            let towards = c / ring.len().max(1) as f64 - mesh.nodes[i].coords;
+            if towards.norm() > 0.0 {
+                pos[i] += towards.normalize() * (1e-9 * spacing[i]);
+            }
+        }
+    }
     let mut lo = Point::new(f64::MAX, f64::MAX, f64::MAX);
     let mut hi = Point::new(f64::MIN, f64::MIN, f64::MIN);
     for p in &mesh.nodes {
@@ -78,7 +108,7 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
     let cloud = Cloud {
         dim: d,
         tau: mesh.tau,
-        pos: mesh.nodes.clone(),
+        pos,
         volume: sys.measure.clone(),
         spacing,
         horizon: vec![0.0; nn],
