@@ -721,3 +721,108 @@ fn crack_plate_resolution_study() {
         eprintln!("{l}");
     }
 }
+
+/// An insulated crack across the whole body (a box polyline running past both sides, and
+/// with a bend) splits it in two: after 50 BE steps each half keeps its energy to round-off
+/// (1e-12 of the total), so the nodes where the crack meets the boundary are duplicated too.
+/// The same crack plate crack given as a polyline along the gmsh mesh's edges splits exactly
+/// the nodes its physical group does.
+#[test]
+fn cracks_split_what_they_should() {
+    let text = r#"
+dimension = 2
+[domain]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[[region]]
+name = "r"
+spacing = 0.05
+horizon = { factor = 3 }
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[[crack]]
+points = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]
+[initial]
+value = "(y > 0.6) * 100"
+[time]
+end = 1.0
+"#;
+    let c = case(text);
+    let model = FemModel::build(&c, None).unwrap();
+    let theta = integrate(&model, Scheme::BackwardEuler, 1.0, 50);
+    let upper = |p: &peritherm::math::Point, cell_centre_y: f64| {
+        if p.x < 0.4 {
+            cell_centre_y > 0.5
+        } else {
+            cell_centre_y > 0.7
+        }
+    };
+    // a node's side is that of the first cell using it
+    let mut side = vec![None; model.mesh.nodes.len()];
+    for cell in &model.mesh.cells {
+        let cy = cell
+            .nodes()
+            .iter()
+            .map(|&n| model.mesh.nodes[n as usize].y)
+            .sum::<f64>()
+            / 4.0;
+        let cx = cell
+            .nodes()
+            .iter()
+            .map(|&n| model.mesh.nodes[n as usize].x)
+            .sum::<f64>()
+            / 4.0;
+        for &n in cell.nodes() {
+            side[n as usize].get_or_insert(upper(&peritherm::math::Point::new(cx, cy, 0.0), cy));
+        }
+    }
+    let energy = |th: &[f64], up: bool| -> f64 {
+        (0..th.len())
+            .filter(|&i| side[i] == Some(up))
+            .map(|i| model.system.capacity[i] * th[i])
+            .sum()
+    };
+    let (u0, l0) = (energy(&model.theta0, true), energy(&model.theta0, false));
+    let (u, l) = (energy(&theta, true), energy(&theta, false));
+    eprintln!("crack across the body: upper side {u0:e} -> {u:e} J, lower side {l0:e} -> {l:e} J");
+    assert!(u0 > 4.0 * l0, "the upper side starts hotter");
+    assert!((u - u0).abs() < 1e-12 * u0 && (l - l0).abs() < 1e-12 * u0);
+    let moved = theta
+        .iter()
+        .zip(&model.theta0)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > 1.0, "heat moves inside the upper half");
+
+    let gmsh = |crack: &str| {
+        let text = format!(
+            r#"
+dimension = 2
+[mesh]
+file = "../meshes/crack_plate_refined.msh"
+thickness = 1e-4
+[[region]]
+name = "zone"
+horizon = {{ factor = 3 }}
+[[region]]
+name = "far"
+horizon = {{ factor = 3 }}
+[material.plate]
+conductivity = 114.0
+density = 1e6
+specific_heat = 1.0
+[[crack]]
+{crack}
+[time]
+end = 0.1
+"#
+        );
+        FemModel::build(&case(&text), None).unwrap().split_nodes
+    };
+    let by_group = gmsh("group = \"crack\"");
+    let by_points = gmsh("points = [[-0.005, 0.0], [0.005, 0.0]]");
+    assert!(by_group > 0);
+    assert_eq!(by_group, by_points);
+}
