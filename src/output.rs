@@ -268,7 +268,7 @@ pub struct RunSummary {
     pub steps: u64,
     /// Time step, s.
     pub dt: f64,
-    /// Stable bound on the step, s.
+    /// Stable bound on the step, s (0 for the FEM solver, whose schemes are unconditionally stable).
     pub dt_stable: f64,
     /// Integrator.
     pub integrator: String,
