@@ -54,8 +54,8 @@ enum Command {
         /// spacing); a gmsh case uses its own mesh.
         #[arg(long)]
         h: Option<f64>,
-        /// Time scheme.
-        #[arg(long, value_enum, default_value = "backward-euler")]
+        /// Time scheme (Crank–Nicolson starts with four backward-Euler half steps).
+        #[arg(long, value_enum, default_value = "crank-nicolson")]
         scheme: FemScheme,
         /// Time step, s (default: min(end/1000, first output/100)).
         #[arg(long)]

@@ -23,7 +23,7 @@ use std::time::Instant;
 pub struct FemOptions {
     /// Element size of the structured mesh of a box case, m (default: the finest region spacing).
     pub h: Option<f64>,
-    /// Time scheme.
+    /// Time scheme (default Crank–Nicolson).
     pub scheme: Scheme,
     /// Time step, s (default [`default_dt`]); steps shrink to land on every output time.
     pub dt: Option<f64>,
@@ -33,7 +33,7 @@ impl Default for FemOptions {
     fn default() -> Self {
         FemOptions {
             h: None,
-            scheme: Scheme::BackwardEuler,
+            scheme: Scheme::CrankNicolson,
             dt: None,
         }
     }
