@@ -215,3 +215,69 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
     }
     Ok(m)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cloud::{BoxRegion, HorizonRule};
+
+    fn region(name: &str, min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> BoxRegion {
+        BoxRegion {
+            name: name.into(),
+            min,
+            max,
+            cells,
+            horizon: HorizonRule::Factor(3.0),
+            material: 0,
+        }
+    }
+
+    /// Region boundaries and a crack that h does not divide still fall on grid lines, cells
+    /// stay no longer than h, and every face gets its boundary facets (tolerance: round-off).
+    #[test]
+    fn interfaces_and_cracks_lie_on_grid_lines() {
+        let g = BoxGeometry {
+            dim: 2,
+            tau: 1.0,
+            min: [0.0, 0.0, 0.0],
+            max: [1.0, 1.0, 0.0],
+            boundary_placement: false,
+            regions: vec![
+                region("a", [0.0, 0.0, 0.0], [0.3, 1.0, 0.0], [3, 10, 1]),
+                region("b", [0.3, 0.0, 0.0], [1.0, 1.0, 0.0], [7, 10, 1]),
+            ],
+        };
+        let crack = Crack {
+            shape: CrackShape::Polyline(vec![
+                Point::new(0.1, 0.37, 0.0),
+                Point::new(0.9, 0.37, 0.0),
+            ]),
+            mu: 0.0,
+            growth: None,
+        };
+        let m = box_mesh(&g, 0.25, &[crack]).unwrap();
+        for x in [0.1, 0.3, 0.9] {
+            assert!(
+                m.nodes.iter().any(|p| (p.x - x).abs() < 1e-12),
+                "no line x = {x}"
+            );
+        }
+        assert!(m.nodes.iter().any(|p| (p.y - 0.37).abs() < 1e-12));
+        for c in &m.cells {
+            let p = m.corners(c);
+            assert!(p[2].x - p[0].x <= 0.25 + 1e-12 && p[2].y - p[0].y <= 0.25 + 1e-12);
+            let cx = 0.25 * (p[0].x + p[1].x + p[2].x + p[3].x);
+            assert_eq!(c.region, u16::from(cx > 0.3));
+        }
+        for face in 0..4 {
+            let length: f64 = m.sets[face]
+                .iter()
+                .map(|&f| {
+                    let n: Vec<u32> = m.facet_nodes(f).collect();
+                    (m.nodes[n[0] as usize] - m.nodes[n[1] as usize]).norm()
+                })
+                .sum();
+            assert!((length - 1.0).abs() < 1e-12, "face {face}: {length}");
+        }
+    }
+}
