@@ -54,6 +54,9 @@ enum Command {
         run: PathBuf,
         /// Output directory of the reference run.
         reference: PathBuf,
+        /// Leave out the nodes within this distance (m) of a crack tip (e.g. 2δ).
+        #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
+        exclude_tips: f64,
     },
     /// Draw a temperature map (PNG) of every output of a 2D run, cracks included, into the
     /// run's directory as map_<k>.png.
@@ -143,7 +146,11 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Compare { run, reference } => compare(&run, &reference),
+        Command::Compare {
+            run,
+            reference,
+            exclude_tips,
+        } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
         Command::Check { case } => {
             let case = Case::load(&case)?;
@@ -168,8 +175,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// `peritherm compare`: max and mean |Δθ| per output time, the reference interpolated at the
-/// run's nodes without looking across the run's cracks.
-fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result<()> {
+/// run's nodes without looking across the run's cracks; nodes within `exclude_tips` (m) of a
+/// crack tip are left out.
+fn compare(
+    run: &std::path::Path,
+    reference: &std::path::Path,
+    exclude_tips: f64,
+) -> anyhow::Result<()> {
     let a = RunSummary::read(run)?;
     let b = RunSummary::read(reference)?;
     let case = Case::load(std::path::Path::new(&a.case))?;
@@ -205,11 +217,13 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
         };
         let fa = read_field(&run.join(&a.fields[k]))?;
         let fb = read_field(&reference.join(&b.fields[kb]))?;
+        let tips = peritherm::crack::tips_at(&cracks, *t);
         let d = field_difference(
             cloud.dim,
             (&fa.pos, &fa.theta),
             (&fb.pos, &fb.theta),
             &cracks,
+            (&tips, exclude_tips),
         );
         say!(
             "| {t} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",

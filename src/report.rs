@@ -92,12 +92,14 @@ pub struct FieldDifference {
 
 /// Compares field A with a reference field B: B is interpolated at each node of A by a
 /// linear least-squares fit over B's 8 (3D: 12) nearest nodes that A's node sees without
-/// crossing a crack (first-order exact: a linear field interpolates without error).
+/// crossing a crack (first-order exact: a linear field interpolates without error). Nodes of
+/// A within `exclude.1` (m) of any point of `exclude.0` (e.g. crack tips) are left out.
 pub fn field_difference(
     dim: usize,
     a: (&[Point], &[f64]),
     b: (&[Point], &[f64]),
     cracks: &[Cutter],
+    exclude: (&[Point], f64),
 ) -> FieldDifference {
     let index = PointIndex::new(b.0);
     let k = if dim == 3 { 12 } else { 8 };
@@ -105,6 +107,9 @@ pub fn field_difference(
         a.0.par_iter()
             .zip(a.1.par_iter())
             .map(|(x, &ta)| {
+                if exclude.0.iter().any(|c| (x - c).norm() < exclude.1) {
+                    return f64::NAN;
+                }
                 let near: Vec<(usize, f64)> = index
                     .nearest(x, 4 * k)
                     .into_iter()
@@ -119,9 +124,10 @@ pub fn field_difference(
         .copied()
         .enumerate()
         .fold((0, 0.0), |m, (i, d)| if d > m.1 { (i, d) } else { m });
+    let kept: Vec<f64> = per_node.into_iter().filter(|d| !d.is_nan()).collect();
     FieldDifference {
         max_abs,
-        mean_abs: per_node.iter().sum::<f64>() / per_node.len().max(1) as f64,
+        mean_abs: kept.iter().sum::<f64>() / kept.len().max(1) as f64,
         at: a.0.get(imax).copied().unwrap_or_else(Point::origin),
     }
 }
