@@ -371,7 +371,11 @@ mod tests {
             arc: 0.0,
         };
         let path = growing_path(&[p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)], 0.0, growth);
-        for (t, tip) in [(0.0, p(0.25, 0.0)), (2.0, p(0.75, 0.0)), (3.0, p(1.0, 0.25))] {
+        for (t, tip) in [
+            (0.0, p(0.25, 0.0)),
+            (2.0, p(0.75, 0.0)),
+            (3.0, p(1.0, 0.25)),
+        ] {
             let tips = tips_at(&path, t);
             let last = tips.last().unwrap();
             assert!((last - tip).norm() < 1e-15, "t = {t}: {tips:?}");
