@@ -26,6 +26,7 @@ pub mod neighbors;
 pub mod operator;
 pub mod output;
 pub mod plot;
+pub mod reference;
 pub mod report;
 pub mod run;
 pub mod solve;
