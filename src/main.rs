@@ -64,6 +64,28 @@ enum Command {
         /// Output directory of `peritherm run`.
         run: PathBuf,
     },
+    /// Run variants of one or more cases and compare each with a reference: writes every run
+    /// into --out/<variant>/, and sweep.csv and sweep.md (one row per variant and output time).
+    Sweep {
+        /// Case files (each is swept over the --vary values; several files are compared as
+        /// one study, e.g. the four (k, m) configurations of seed 004).
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// KEY=V1,V2,...: a dotted key of the case file and its values (array items by index,
+        /// or `*` for all: `region.*.horizon.factor=2,3,4,5`). Repeat for a product.
+        #[arg(long)]
+        vary: Vec<peritherm::sweep::Vary>,
+        /// Output directory (created if missing).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Compare with this finished run's fields instead of the cases' own [reference] (the
+        /// default when every case has one; otherwise the first variant).
+        #[arg(long, value_name = "RUN_DIR")]
+        against: Option<PathBuf>,
+        /// Leave out the nodes within this distance (m) of a crack tip in field comparisons.
+        #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
+        exclude_tips: f64,
+    },
     /// Validate a case and print its size and stable time step without running it.
     Check {
         /// The case file (TOML).
@@ -152,6 +174,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             exclude_tips,
         } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
+        Command::Sweep {
+            cases,
+            vary,
+            out,
+            against,
+            exclude_tips,
+        } => sweep(&cases, &vary, &out, against, exclude_tips),
         Command::Check { case } => {
             let case = Case::load(&case)?;
             let model =
@@ -234,6 +263,50 @@ fn compare(
             d.at.z
         );
     }
+    Ok(())
+}
+
+/// `peritherm sweep`: the variants of every case, run and compared; the table printed and
+/// written as sweep.csv and sweep.md.
+fn sweep(
+    cases: &[PathBuf],
+    vary: &[peritherm::sweep::Vary],
+    out: &std::path::Path,
+    against: Option<PathBuf>,
+    exclude_tips: f64,
+) -> anyhow::Result<()> {
+    use peritherm::sweep::{self, Against};
+    let mut variants = Vec::new();
+    for path in cases {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{}: cannot read", path.display()))?;
+        let prefix = if cases.len() > 1 {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
+        let mut v = sweep::variants(&text, path, &prefix, vary)?;
+        if v.len() == 1 && v[0].label.is_empty() {
+            v[0].label = "run".into();
+        }
+        variants.extend(v);
+    }
+    let against = match against {
+        Some(dir) => Against::Run(dir),
+        None if variants.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
+        None => Against::First,
+    };
+    let n = variants.len();
+    let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
+        eprintln!("[{}/{n}] {label}", k + 1);
+    })?;
+    let table = sweep::markdown(&rows);
+    peritherm::output::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
+    peritherm::output::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    say!("{table}");
+    say!("-> {}", out.join("sweep.csv").display());
     Ok(())
 }
 
