@@ -1,11 +1,12 @@
 //! Log–log convergence plots (error against δ, m or spacing) with fitted power-law rates.
 
 use super::line::check_series;
+use super::FONT;
 use super::{extent, palette, plot_error, render, sci, DrawError, Figure, Labels, Legend, Series};
-use super::{Style, FONT};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// A power law y = coefficient · x^rate.
@@ -68,9 +69,8 @@ pub fn fit_rate(xs: &[f64], ys: &[f64]) -> Result<f64> {
     fit_power_law(xs, ys).map(|p| p.rate)
 }
 
-/// Draws each series on log–log axes (markers joined by a thin line, its own style
-/// ignored) with its least-squares power law as a dashed line of the same colour, the rate
-/// in the legend ("name (rate 1.07)"), into `<stem>.png` and `<stem>.svg` (900 × 600 px).
+/// Draws each series on log–log axes as markers (its `style` is ignored) with its
+/// least-squares power law as a dashed line of the same colour, the rate in the legend ("name (rate 1.07)"), into `<stem>.png` and `<stem>.svg` (900 × 600 px).
 /// Returns the fitted laws in the order of `series`; every series needs two or more
 /// distinct positive x and positive y.
 pub fn convergence_plot(
@@ -119,7 +119,38 @@ fn log_tick(v: f64) -> String {
     }
 }
 
-/// A convergence plot ready to draw.
+/// Ticks of a log axis from 10^lo to 10^hi: (value, labelled). Every decade is labelled
+/// (every n-th beyond eight decades); 2 and 5 times a decade too below four decades, 3 times
+/// below one and a half, every integer multiple below 0.8 decades; unlabelled ticks mark the other integer
+/// multiples when the axis spans fewer than six decades.
+fn log_ticks(lo: f64, hi: f64) -> Vec<(f64, bool)> {
+    let span = hi - lo;
+    let mut out = Vec::new();
+    let first = lo.floor() as i32;
+    let last = hi.ceil() as i32;
+    let step = ((span / 8.0).ceil() as i32).max(1);
+    for k in first..=last {
+        for m in 1..=9 {
+            let v = m as f64 * 10f64.powi(k);
+            let l = v.log10();
+            if l < lo || l > hi {
+                continue;
+            }
+            let label = match m {
+                1 => k.rem_euclid(step) == 0,
+                2 | 5 => span < 4.0,
+                3 => span < 1.5,
+                _ => span < 0.8,
+            };
+            if label || span < 6.0 {
+                out.push((v, label));
+            }
+        }
+    }
+    out
+}
+
+/// A convergence plot ready to draw (coordinates are log10 of the data).
 struct Convergence<'a> {
     labels: &'a Labels,
     series: &'a [Series],
@@ -141,35 +172,64 @@ impl Figure for Convergence<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let (x, y) = (self.x, self.y);
+        let lg = |p: (f64, f64)| (p.0.log10(), p.1.log10());
+        let (x0, y0) = lg((self.x.0, self.y.0));
+        let (x1, y1) = lg((self.x.1, self.y.1));
         let mut chart = ChartBuilder::on(root)
             .caption(&self.labels.title, (FONT, 26))
             .margin(15)
             .x_label_area_size(55)
             .y_label_area_size(85)
-            .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())?;
-        let f = |v: &f64| log_tick(*v);
+            .build_cartesian_2d(x0..x1, y0..y1)?;
         chart
             .configure_mesh()
+            .disable_mesh()
+            .x_labels(0)
+            .y_labels(0)
             .x_desc(&self.labels.x)
             .y_desc(&self.labels.y)
-            .label_style((FONT, 18))
             .axis_desc_style((FONT, 20))
-            .x_label_formatter(&f)
-            .y_label_formatter(&f)
-            .bold_line_style(BLACK.mix(0.12))
-            .light_line_style(TRANSPARENT)
             .draw()?;
+        // log ticks, grid lines and labels by hand (plotters' log axes skip the values
+        // below the first power of ten)
+        let label = TextStyle::from((FONT, 18).into_font()).color(&BLACK);
+        let grid = |bold: bool| BLACK.mix(if bold { 0.15 } else { 0.06 }).stroke_width(1);
+        for (v, bold) in log_ticks(x0, x1) {
+            let l = v.log10();
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(l, y0), (l, y1)],
+                grid(bold),
+            )))?;
+            let (px, py) = chart.backend_coord(&(l, y0));
+            let len = if bold { 6 } else { 3 };
+            root.draw(&PathElement::new(vec![(px, py), (px, py + len)], BLACK))?;
+            if bold {
+                let style = label.pos(Pos::new(HPos::Center, VPos::Top));
+                root.draw(&Text::new(log_tick(v), (px, py + 9), style))?;
+            }
+        }
+        for (v, bold) in log_ticks(y0, y1) {
+            let l = v.log10();
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(x0, l), (x1, l)],
+                grid(bold),
+            )))?;
+            let (px, py) = chart.backend_coord(&(x0, l));
+            let len = if bold { 6 } else { 3 };
+            root.draw(&PathElement::new(vec![(px - len, py), (px, py)], BLACK))?;
+            if bold {
+                let style = label.pos(Pos::new(HPos::Right, VPos::Center));
+                root.draw(&Text::new(log_tick(v), (px - 9, py), style))?;
+            }
+        }
         for (s, law) in self.series.iter().zip(self.laws) {
             let c = palette(s.colour);
             let (a, b) = extent(s.points.iter().map(|p| p.0));
-            let fit = [(a, law.at(a)), (b, law.at(b))];
-            chart.draw_series(DashedLineSeries::new(fit, 9, 5, c.stroke_width(1)))?;
-            let pts = s.points.iter().copied();
-            if s.style != Style::Markers {
-                chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?;
-            }
+            let fit = [lg((a, law.at(a))), lg((b, law.at(b)))];
+            let line = c.stroke_width(2);
+            chart.draw_series(DashedLineSeries::new(fit, 10, 6, line))?;
             let dot = c.filled();
+            let pts = s.points.iter().map(|&p| lg(p));
             let anno = chart.draw_series(pts.map(|p| Circle::new(p, 5, dot)))?;
             let name = if s.name.is_empty() {
                 format!("rate {:.2}", law.rate)
@@ -178,7 +238,8 @@ impl Figure for Convergence<'_> {
             };
             anno.label(name).legend(move |(x, y)| {
                 EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (24, 0)], c.stroke_width(2))
+                    + PathElement::new(vec![(0, 0), (8, 0)], line)
+                    + PathElement::new(vec![(16, 0), (24, 0)], line)
                     + Circle::new((12, 0), 5, dot)
             });
         }
@@ -225,9 +286,26 @@ mod tests {
 
     /// Log tick labels.
     #[test]
-    fn log_ticks() {
+    fn log_tick_labels() {
         assert_eq!(log_tick(0.002), "0.002");
         assert_eq!(log_tick(5e-5), "5e-5");
         assert_eq!(log_tick(10.0), "10");
+        let labelled = |lo: f64, hi: f64| -> Vec<f64> {
+            log_ticks(lo, hi)
+                .into_iter()
+                .filter(|t| t.1)
+                .map(|t| t.0)
+                .collect()
+        };
+        let same = |a: Vec<f64>, b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() < 1e-12)
+        };
+        assert!(same(labelled(-3.6, -3.1), &[3e-4, 4e-4, 5e-4, 6e-4, 7e-4]));
+        assert!(same(labelled(-3.9, -2.9), &[2e-4, 3e-4, 5e-4, 1e-3]));
+        assert!(same(
+            labelled(-4.2, -2.3),
+            &[1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3]
+        ));
+        assert_eq!(labelled(-12.5, 0.0).len(), 7);
     }
 }

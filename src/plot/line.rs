@@ -121,7 +121,7 @@ pub(super) fn check_series(stem: &Path, series: &[Series], positive: bool) -> Re
 }
 
 /// Draws `series` against linear axes into `<stem>.png` and `<stem>.svg` (900 × 600 px):
-/// the x range is that of the data, the y range the data's with 5 % margins.
+/// the ranges are the data's with margins of 1 % (x) and 5 % (y).
 pub fn line_plot(stem: &Path, labels: &Labels, series: &[Series], legend: Legend) -> Result<()> {
     check_series(stem, series, false)?;
     let all = || series.iter().flat_map(|s| s.points.iter());
@@ -135,11 +135,12 @@ pub fn line_plot(stem: &Path, labels: &Labels, series: &[Series], legend: Legend
     let (y0, y1) = extent(all().map(|p| p.1));
     let (y0, y1) = super::widen(y0, y1);
     let pad = 0.05 * (y1 - y0);
+    let margin = 0.01 * (x.1 - x.0);
     let fig = LinePlot {
         labels,
         series,
         legend,
-        x,
+        x: (x.0 - margin, x.1 + margin),
         y: (y0 - pad, y1 + pad),
     };
     render(stem, &fig)
@@ -179,6 +180,7 @@ impl Figure for LinePlot<'_> {
         let fy = |v: &f64| tick_label(*v, ys, yl);
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(5)
             .x_desc(&self.labels.x)
             .y_desc(&self.labels.y)
             .label_style((FONT, 18))

@@ -299,11 +299,24 @@ impl Figure for MapFigure<'_> {
                 .iter()
                 .map(|s| PathElement::new(s.to_vec(), grey)),
         )?;
-        chart.draw_series(map.cracks.iter().map(|c| {
-            PathElement::new(
-                vec![(c[0].x, c[0].y), (c[1].x, c[1].y)],
-                BLACK.stroke_width(4),
-            )
+        // cracks as filled bands 4 px wide (thick plotters lines leave pinholes)
+        chart.draw_series(map.cracks.iter().filter_map(|c| {
+            let (dx, dy) = (c[1].x - c[0].x, c[1].y - c[0].y);
+            let len = dx.hypot(dy);
+            (len > 0.0).then(|| {
+                let (nx, ny) = (-dy / len * 2.0 * per_px, dx / len * 2.0 * per_px);
+                let (tx, ty) = (dx / len * per_px, dy / len * per_px);
+                let (a, b) = ((c[0].x - tx, c[0].y - ty), (c[1].x + tx, c[1].y + ty));
+                Polygon::new(
+                    vec![
+                        (a.0 + nx, a.1 + ny),
+                        (b.0 + nx, b.1 + ny),
+                        (b.0 - nx, b.1 - ny),
+                        (a.0 - nx, a.1 - ny),
+                    ],
+                    BLACK.filled(),
+                )
+            })
         }))?;
         let mut longest = 0.0;
         if let Some(flux) = map.flux {
@@ -319,6 +332,7 @@ impl Figure for MapFigure<'_> {
         let fy = |v: &f64| tick_label(*v, ys, yl);
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(5)
             .disable_mesh()
             .x_desc(format!("x ({unit})"))
             .y_desc(format!("y ({unit})"))
@@ -353,6 +367,7 @@ impl Figure for MapFigure<'_> {
         let (bs, bl) = (hi - lo, lo.abs().max(hi.abs()));
         let fb = |v: &f64| tick_label(*v, bs, bl);
         cb.configure_mesh()
+            .set_all_tick_mark_size(5)
             .disable_x_axis()
             .disable_mesh()
             .y_labels(8)
