@@ -58,8 +58,8 @@ enum Command {
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
     },
-    /// Draw a temperature map (PNG) of every output of a 2D run, cracks included, into the
-    /// run's directory as map_<k>.png.
+    /// Draw temperature maps (PNG and SVG) of every output of a 2D run, cracks included, into
+    /// the run's directory as map_<k>.png/.svg, and damage_<k>.png/.svg for runs with cracks.
     Plot {
         /// Output directory of `peritherm run`.
         run: PathBuf,
@@ -310,8 +310,11 @@ fn sweep(
     Ok(())
 }
 
-/// `peritherm plot`: one temperature map per output, on a colour range shared by all of them.
+/// `peritherm plot`: per output a temperature map (one colour range for all outputs, cracks as
+/// they are at that time, region boundaries, flux arrows when the run has cracks) and, for runs
+/// with damage, a damage map; PNG and SVG.
 fn plot(run: &std::path::Path) -> anyhow::Result<()> {
+    use peritherm::plot::{field_map, ColourMap, FieldMap};
     let summary = RunSummary::read(run)?;
     let case = Case::load(std::path::Path::new(&summary.case))?;
     if case.spec.geometry.bare_cloud()?.dim != 2 {
@@ -331,14 +334,40 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
         .iter()
         .flat_map(|f| f.theta.iter())
         .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    let range = (hi > lo).then_some((lo, hi));
+    let cracked = fields.iter().any(|f| f.damage.iter().any(|&d| d > 0.0));
+    let name = if summary.title.is_empty() {
+        summary.case.clone()
+    } else {
+        summary.title.clone()
+    };
     for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
-        let path = run.join(format!("map_{}.png", k + 1));
         let cracks = peritherm::crack::segments_at(&cutters, *t);
-        peritherm::plot::temperature_map(&path, &f.pos, &f.theta, &f.spacing, (lo, hi), &cracks)?;
+        let several_regions = f.region.iter().any(|&r| r != f.region[0]);
+        let mut map = FieldMap::new(&f.pos, &f.theta, &f.spacing);
+        map.title = format!("{name}: temperature at t = {t} s");
+        map.quantity = "Temperature (°C)".into();
+        map.range = range;
+        map.cracks = &cracks;
+        map.regions = several_regions.then_some(&f.region[..]);
+        map.flux = cracked.then_some(&f.flux[..]);
+        let stem = run.join(format!("map_{}", k + 1));
+        field_map(&stem, &map)?;
         say!(
-            "t = {t} s: {} (blue {lo:.2} °C … white … red {hi:.2} °C)",
-            path.display()
+            "t = {t} s: {}.png/.svg (blue {lo:.2} °C … white … red {hi:.2} °C)",
+            stem.display()
         );
+        if cracked {
+            let mut map = FieldMap::new(&f.pos, &f.damage, &f.spacing);
+            map.title = format!("{name}: damage at t = {t} s");
+            map.quantity = "Damage φ (–)".into();
+            map.colour_map = ColourMap::Sequential;
+            map.range = Some((0.0, 1.0));
+            map.cracks = &cracks;
+            let stem = run.join(format!("damage_{}", k + 1));
+            field_map(&stem, &map)?;
+            say!("t = {t} s: {}.png/.svg (damage 0 … 1)", stem.display());
+        }
     }
     Ok(())
 }

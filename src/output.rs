@@ -170,9 +170,16 @@ pub struct FieldRows {
     pub theta: Vec<f64>,
     /// Spacings Δ, m.
     pub spacing: Vec<f64>,
+    /// Region index of each node (0 if the file has no such column).
+    pub region: Vec<u32>,
+    /// Damage φ of each node (0 if the file has no such column).
+    pub damage: Vec<f64>,
+    /// Peridynamic heat flux of each node, W/m² (0 if the file has no such columns).
+    pub flux: Vec<Vector>,
 }
 
-/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first).
+/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first; damage and
+/// qx, qy, qz when present).
 pub fn read_field(path: &Path) -> Result<FieldRows> {
     let bad = |m: String| Error::Io {
         path: path.to_path_buf(),
@@ -195,11 +202,14 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         pos: Vec::new(),
         theta: Vec::new(),
         spacing: Vec::new(),
+        region: Vec::new(),
+        damage: Vec::new(),
+        flux: Vec::new(),
     };
     for (k, line) in lines.enumerate() {
         let v: Vec<f64> = line
             .split(',')
-            .take(6)
+            .take(12)
             .map(str::parse)
             .collect::<std::result::Result<_, _>>()
             .map_err(|e| bad(format!("line {}: {e}", k + 2)))?;
@@ -209,6 +219,10 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         rows.pos.push(Point::new(v[0], v[1], v[2]));
         rows.theta.push(v[3]);
         rows.spacing.push(v[5]);
+        rows.region.push(v[4] as u32);
+        let extra = |k: usize| v.get(k).copied().unwrap_or(0.0);
+        rows.damage.push(extra(8));
+        rows.flux.push(Vector::new(extra(9), extra(10), extra(11)));
     }
     Ok(rows)
 }
