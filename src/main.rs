@@ -86,6 +86,19 @@ enum Command {
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
     },
+    /// Run cases and write reports: plots of PD against the reference along the probe lines,
+    /// the error along them, temperature/damage/flux maps, report.md and index.html.
+    Report {
+        /// Case files, or directories of case files.
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// Output directory: one subdirectory per case, and an index over several.
+        #[arg(long, short)]
+        out: PathBuf,
+        /// No progress lines.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Validate a case and print its size and stable time step without running it.
     Check {
         /// The case file (TOML).
@@ -174,6 +187,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             exclude_tips,
         } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
+        Command::Report { cases, out, quiet } => report(&cases, &out, quiet),
         Command::Sweep {
             cases,
             vary,
@@ -314,7 +328,6 @@ fn sweep(
 /// they are at that time, region boundaries, flux arrows when the run has cracks) and, for runs
 /// with damage, a damage map; PNG and SVG.
 fn plot(run: &std::path::Path) -> anyhow::Result<()> {
-    use peritherm::plot::{field_map, ColourMap, FieldMap};
     let summary = RunSummary::read(run)?;
     let case = Case::load(std::path::Path::new(&summary.case))?;
     if case.spec.geometry.bare_cloud()?.dim != 2 {
@@ -323,51 +336,61 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
             run.display()
         );
     }
-    let cloud = case.spec.geometry.bare_cloud()?;
-    let cutters = crack_cutters(&cloud, &case.spec.cracks);
     let fields = summary
         .fields
         .iter()
         .map(|f| read_field(&run.join(f)))
         .collect::<Result<Vec<_>, _>>()?;
-    let (lo, hi) = fields
-        .iter()
-        .flat_map(|f| f.theta.iter())
-        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
-    let range = (hi > lo).then_some((lo, hi));
-    let cracked = fields.iter().any(|f| f.damage.iter().any(|&d| d > 0.0));
-    let name = if summary.title.is_empty() {
-        summary.case.clone()
-    } else {
-        summary.title.clone()
-    };
-    for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
-        let cracks = peritherm::crack::segments_at(&cutters, *t);
-        let several_regions = f.region.iter().any(|&r| r != f.region[0]);
-        let mut map = FieldMap::new(&f.pos, &f.theta, &f.spacing);
-        map.title = format!("{name}: temperature at t = {t} s");
-        map.quantity = "Temperature (°C)".into();
-        map.range = range;
-        map.cracks = &cracks;
-        map.regions = several_regions.then_some(&f.region[..]);
-        map.flux = cracked.then_some(&f.flux[..]);
-        let stem = run.join(format!("map_{}", k + 1));
-        field_map(&stem, &map)?;
-        say!(
-            "t = {t} s: {}.png/.svg (blue {lo:.2} °C … white … red {hi:.2} °C)",
-            stem.display()
-        );
-        if cracked {
-            let mut map = FieldMap::new(&f.pos, &f.damage, &f.spacing);
-            map.title = format!("{name}: damage at t = {t} s");
-            map.quantity = "Damage φ (–)".into();
-            map.colour_map = ColourMap::Sequential;
-            map.range = Some((0.0, 1.0));
-            map.cracks = &cracks;
-            let stem = run.join(format!("damage_{}", k + 1));
-            field_map(&stem, &map)?;
-            say!("t = {t} s: {}.png/.svg (damage 0 … 1)", stem.display());
+    for stem in peritherm::report::page::draw_maps(&case, &summary, &fields, run)? {
+        say!("{}.png/.svg", stem.display());
+    }
+    Ok(())
+}
+
+/// `peritherm report`: runs each case (directories: every case file in them) and writes its
+/// report into --out/<case>/; with several cases, one index over all of them.
+fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Result<()> {
+    use peritherm::case::ReferenceSource;
+    use peritherm::report::page::{write_index, write_report};
+    let mut cases = Vec::new();
+    for p in inputs {
+        if p.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(p)
+                .with_context(|| format!("{}: cannot list", p.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .collect();
+            found.sort();
+            cases.extend(found);
+        } else {
+            cases.push(p.clone());
         }
+    }
+    let mut written = Vec::new();
+    for path in &cases {
+        let case = Case::load(path)?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "case".into());
+        let dir = out.join(&stem);
+        let run = dir.join("run");
+        if !quiet {
+            eprintln!("{}: running into {}", path.display(), run.display());
+        }
+        run_case(&case, &run, |_, _| {})?;
+        let reference = match case.reference.as_ref().map(|r| &r.source) {
+            Some(ReferenceSource::Analytic(_)) => "series",
+            Some(ReferenceSource::Table(_)) => "reference table",
+            None => "none",
+        };
+        let w = write_report(&case, &run, &dir, reference)?;
+        say!("{}: {}", path.display(), dir.join("index.html").display());
+        written.push(w);
+    }
+    if written.len() > 1 {
+        write_index(out, &written)?;
+        say!("index: {}", out.join("index.html").display());
     }
     Ok(())
 }
