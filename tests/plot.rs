@@ -211,6 +211,10 @@ fn bad_input_is_a_typed_error() {
     assert!(is_plot(map(&ok, &ok, Some((5.0, 5.0)))).contains("colour range"));
     // a uniform field is not an error: the colour range is widened around the value
     map(&[3.0, 3.0], &ok, None).unwrap();
+    // a file that cannot be written is a plot error too
+    let nowhere = dir.path().join("missing").join("plot");
+    let good = [Series::new("a", vec![(0.0, 1.0), (1.0, 2.0)])];
+    assert!(is_plot(line_plot(&nowhere, &labels, &good, Legend::None)).contains("png"));
 }
 
 const SMALL: &str = r#"

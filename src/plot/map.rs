@@ -51,6 +51,36 @@ pub struct FieldMap<'a> {
     pub flux_unit: String,
     /// Arrow grid cells along the longer side of the map (20 by default).
     pub arrows: usize,
+    /// Side of each node's square in spacings; None (the default): 1 on a lattice cloud,
+    /// [`IRREGULAR_SQUARE`] when the nearest neighbours are not at distance Δ (mesh clouds),
+    /// so that the squares leave no holes.
+    pub square: Option<f64>,
+}
+
+/// Side of the squares, in spacings, on clouds that are not lattices.
+pub const IRREGULAR_SQUARE: f64 = 1.6;
+
+/// 1 if (almost) every node's nearest neighbour is at its spacing Δ (a lattice), else
+/// [`IRREGULAR_SQUARE`].
+fn square_side(pos: &[Point], spacing: &[f64]) -> f64 {
+    let flat: Vec<Point> = pos.iter().map(|p| Point::new(p.x, p.y, 0.0)).collect();
+    let index = PointIndex::new(&flat);
+    let step = (flat.len() / 2000).max(1);
+    let (mut lattice, mut seen) = (0usize, 0usize);
+    for i in (0..flat.len()).step_by(step) {
+        let Some(&(_, d)) = index.nearest(&flat[i], 2).get(1) else {
+            continue;
+        };
+        seen += 1;
+        if (d - spacing[i]).abs() <= 1e-6 * spacing[i] {
+            lattice += 1;
+        }
+    }
+    if seen == 0 || lattice as f64 >= 0.9 * seen as f64 {
+        1.0
+    } else {
+        IRREGULAR_SQUARE
+    }
 }
 
 impl<'a> FieldMap<'a> {
@@ -70,6 +100,7 @@ impl<'a> FieldMap<'a> {
             flux: None,
             flux_unit: "W/m²".into(),
             arrows: 20,
+            square: None,
         }
     }
 }
@@ -135,6 +166,12 @@ pub fn field_map(stem: &Path, map: &FieldMap) -> Result<()> {
             widen(lo, hi)
         }
     };
+    if map.square.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
+        return Err(plot_error(stem, "the square size must be positive"));
+    }
+    let side = map
+        .square
+        .unwrap_or_else(|| square_side(map.pos, map.spacing));
     let r = |i: usize| map.spacing[i] / 2.0;
     let x = extent((0..n).flat_map(|i| [map.pos[i].x - r(i), map.pos[i].x + r(i)]));
     let y = extent((0..n).flat_map(|i| [map.pos[i].y - r(i), map.pos[i].y + r(i)]));
@@ -158,6 +195,7 @@ pub fn field_map(stem: &Path, map: &FieldMap) -> Result<()> {
             .regions
             .map(|reg| outlines(map, reg))
             .unwrap_or_default(),
+        side,
     };
     render(stem, &fig)
 }
@@ -245,6 +283,7 @@ struct MapFigure<'a> {
     y: (f64, f64),
     size: (u32, u32),
     outlines: Vec<[(f64, f64); 2]>,
+    side: f64,
 }
 
 impl Figure for MapFigure<'_> {
@@ -287,9 +326,14 @@ impl Figure for MapFigure<'_> {
         let (lo, hi) = self.range;
         let pad = 0.5 * per_px; // half a pixel of overlap hides seams between squares
         chart.draw_series((0..map.pos.len()).map(|i| {
-            let (p, r) = (map.pos[i], 0.5 * map.spacing[i] + pad);
+            let (p, r) = (map.pos[i], 0.5 * self.side * map.spacing[i] + pad);
+            // larger squares than Δ (irregular clouds) stay inside the cloud's box
+            let (bx, by) = (self.x, self.y);
             Rectangle::new(
-                [(p.x - r, p.y - r), (p.x + r, p.y + r)],
+                [
+                    ((p.x - r).max(bx.0), (p.y - r).max(by.0)),
+                    ((p.x + r).min(bx.1), (p.y + r).min(by.1)),
+                ],
                 map.colour_map.colour(map.value[i], lo, hi).filled(),
             )
         }))?;
@@ -421,5 +465,26 @@ fn short(v: f64) -> String {
         }
     } else {
         super::sci(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Squares of Δ on a lattice, larger on a jittered cloud.
+    #[test]
+    fn square_side_follows_the_cloud() {
+        let lattice: Vec<Point> = (0..100)
+            .map(|k| Point::new((k % 10) as f64 * 0.1, (k / 10) as f64 * 0.1, 0.0))
+            .collect();
+        let h = vec![0.1; 100];
+        assert_eq!(square_side(&lattice, &h), 1.0);
+        let jittered: Vec<Point> = lattice
+            .iter()
+            .enumerate()
+            .map(|(k, p)| Point::new(p.x + 0.013 * ((k * 7 % 5) as f64 - 2.0), p.y, 0.0))
+            .collect();
+        assert_eq!(square_side(&jittered, &h), IRREGULAR_SQUARE);
     }
 }
