@@ -316,11 +316,28 @@ fn sweep(
     let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
         eprintln!("[{}/{n}] {label}", k + 1);
     })?;
-    let table = sweep::markdown(&rows);
+    let mut table = sweep::markdown(&rows);
+    let rates = sweep::convergence_plots(&rows, out)?;
+    let lines = sweep::line_plots(&variants, &rows, out, &against)?;
+    if !rates.is_empty() {
+        table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
+        for (stem, series, rate) in &rates {
+            table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
+        }
+    }
+    let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
+    plots.dedup();
+    plots.extend(lines.iter());
+    if !plots.is_empty() {
+        table.push('\n');
+        for p in plots {
+            table.push_str(&format!("![{p}]({p}.png)\n\n"));
+        }
+    }
     peritherm::output::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
     peritherm::output::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
     say!("{table}");
-    say!("-> {}", out.join("sweep.csv").display());
+    say!("-> {}", out.join("sweep.md").display());
     Ok(())
 }
 
