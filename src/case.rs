@@ -14,10 +14,12 @@ use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use crate::material::{BondRule, Material};
 use crate::math::Point;
 use crate::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
+use crate::reference::ReferenceTable;
 use crate::solve::explicit::Integrator;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// A number or an expression string.
 #[derive(Debug, Clone, Deserialize)]
@@ -67,7 +69,7 @@ pub struct CaseFile {
     pub time: TimeSpec,
     /// Classical reference to compare with.
     #[serde(default)]
-    pub reference: Option<ReferenceSpec>,
+    pub reference: Option<ReferenceSection>,
 }
 
 /// `[domain]`.
@@ -312,18 +314,47 @@ fn default_integrator() -> Integrator {
     Integrator::Rk4
 }
 
-/// `[reference]`: a classical solution and where to compare.
+/// `[reference]` as written: one classical solution and where to compare.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ReferenceSpec {
-    /// The analytical solution and its parameters.
-    pub solution: Reference,
-    /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`.
+pub struct ReferenceSection {
+    /// An analytical solution and its parameters.
+    #[serde(default)]
+    pub solution: Option<Reference>,
+    /// A CSV table exported by another code (path relative to the case file).
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`, m.
     #[serde(default)]
     pub line_y: Option<f64>,
+    /// A vertical probe line x = `line_x` for the report's plots (seed 004 §4.3), m.
+    #[serde(default)]
+    pub line_x: Option<f64>,
     /// A point whose nearest body node is reported at every output (e.g. seed 000's midpoint), m.
     #[serde(default)]
     pub probe: Option<Vec<f64>>,
+}
+
+/// Where the classical temperatures of a reference come from.
+#[derive(Debug, Clone)]
+pub enum ReferenceSource {
+    /// An analytical series of [`crate::analytic`].
+    Analytic(Reference),
+    /// A table exported by another code, interpolated at the nodes.
+    Table(Arc<ReferenceTable>),
+}
+
+/// A validated reference: its source and where to compare.
+#[derive(Debug, Clone)]
+pub struct ReferenceSpec {
+    /// The classical solution.
+    pub source: ReferenceSource,
+    /// Probe line for seed 003 eq 13 (y = line_y), m.
+    pub line_y: Option<f64>,
+    /// Vertical probe line x = line_x of the report, m.
+    pub line_x: Option<f64>,
+    /// The point whose nearest body node is reported, m.
+    pub probe: Option<Point>,
 }
 
 /// A validated case: the model spec plus run settings.
@@ -382,6 +413,58 @@ fn expr(v: &ValueSpec, path: &Path, key: &str) -> Result<Expr> {
         ValueSpec::Number(x) => Err(case_err(path, key, format!("must be finite, got {x}"))),
         ValueSpec::Expr(s) => Expr::parse(s).map_err(|e| case_err(path, key, e.to_string())),
     }
+}
+
+/// Validates `[reference]`: exactly one source, a table that has every output time.
+fn reference(
+    r: ReferenceSection,
+    path: &Path,
+    dim: usize,
+    outputs: &[f64],
+) -> Result<ReferenceSpec> {
+    let probe = match &r.probe {
+        Some(p) => {
+            let c = coords(path, dim, p, "reference.probe")?;
+            Some(Point::new(c[0], c[1], c[2]))
+        }
+        None => None,
+    };
+    for (key, v) in [
+        ("reference.line_y", r.line_y),
+        ("reference.line_x", r.line_x),
+    ] {
+        if v.is_some_and(|v| !v.is_finite() || dim < 2) {
+            return Err(case_err(
+                path,
+                key,
+                "must be a finite coordinate of a 2D or 3D case",
+            ));
+        }
+    }
+    let source = match (r.solution, r.file) {
+        (Some(s), None) => ReferenceSource::Analytic(s),
+        (None, Some(file)) => {
+            let file = path.parent().unwrap_or(Path::new(".")).join(file);
+            let table = ReferenceTable::read(&file, dim)?;
+            table
+                .check_times(outputs)
+                .map_err(|m| case_err(path, "reference.file", m))?;
+            ReferenceSource::Table(Arc::new(table))
+        }
+        _ => {
+            return Err(case_err(
+                path,
+                "reference",
+                "give exactly one of `solution` (analytical) or `file` (a CSV table)",
+            ))
+        }
+    };
+    Ok(ReferenceSpec {
+        source,
+        line_y: r.line_y,
+        line_x: r.line_x,
+        probe,
+    })
 }
 
 fn case_err(path: &Path, key: &str, message: impl Into<String>) -> Error {
@@ -1062,12 +1145,11 @@ impl CaseFile {
                 ));
             }
         }
-        if let Some(r) = &self.reference {
-            if let Some(p) = &r.probe {
-                coords(path, dim, p, "reference.probe")?;
-            }
-        }
         let cracks = self.cracks(path, dim, &set_names, &geometry, &faces)?;
+        let reference = match self.reference {
+            Some(r) => Some(reference(r, path, dim, &outputs)?),
+            None => None,
+        };
         Ok(Case {
             path: path.to_path_buf(),
             title: self.title,
@@ -1087,7 +1169,7 @@ impl CaseFile {
             dt: self.time.dt,
             end,
             outputs,
-            reference: self.reference,
+            reference,
         })
     }
 }

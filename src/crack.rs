@@ -320,19 +320,34 @@ pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {
 
 /// The 2D crack segments present at time `t` (growing cracks up to their tips), m.
 pub fn segments_at(cutters: &[Cutter], t: f64) -> Vec<[Point; 2]> {
+    present(cutters, t).map(|(s, _)| s).collect()
+}
+
+/// The 2D crack tips at time `t` (the free ends of standing cracks and the moving ends of
+/// growing ones), m.
+pub fn tips_at(cutters: &[Cutter], t: f64) -> Vec<Point> {
+    present(cutters, t)
+        .flat_map(|(s, tip)| (0..2).filter(move |&k| tip[k]).map(move |k| s[k]))
+        .collect()
+}
+
+/// Each 2D crack segment present at time `t`, with whether each of its ends is a tip.
+fn present(cutters: &[Cutter], t: f64) -> impl Iterator<Item = ([Point; 2], [bool; 2])> + '_ {
     cutters
         .iter()
         .filter(|c| c.corners.len() == 2 && c.boundary.is_none())
-        .filter_map(|c| {
+        .filter_map(move |c| {
             let (a, b) = (c.corners[0], c.corners[1]);
             let Some(g) = c.growth else {
-                return Some([a, b]);
+                return Some(([a, b], c.tips));
             };
             let covered = g.initial + g.speed * (t - g.start).max(0.0) - g.arc;
             let len = (b - a).norm();
-            (covered > 0.0).then(|| [a, a + (b - a) * (covered / len).min(1.0)])
+            (covered > 0.0).then(|| {
+                let end = (covered / len).min(1.0);
+                ([a, a + (b - a) * end], [c.tips[0], c.tips[1] || end < 1.0])
+            })
         })
-        .collect()
 }
 
 #[cfg(test)]
@@ -341,6 +356,30 @@ mod tests {
 
     fn p(x: f64, y: f64) -> Point {
         Point::new(x, y, 0.0)
+    }
+
+    /// A standing crack has its two ends as tips; a growing crack's tip moves along its
+    /// path at its speed (exact arithmetic on these numbers, so compared to 1e-15).
+    #[test]
+    fn tips_of_standing_and_growing_cracks() {
+        let standing = segments(&[[p(0.0, 0.0), p(1.0, 0.0)]], 0.0);
+        assert_eq!(tips_at(&standing, 0.0), vec![p(0.0, 0.0), p(1.0, 0.0)]);
+        let growth = Growth {
+            start: 1.0,
+            speed: 0.5,
+            initial: 0.25,
+            arc: 0.0,
+        };
+        let path = growing_path(&[p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)], 0.0, growth);
+        for (t, tip) in [
+            (0.0, p(0.25, 0.0)),
+            (2.0, p(0.75, 0.0)),
+            (3.0, p(1.0, 0.25)),
+        ] {
+            let tips = tips_at(&path, t);
+            let last = tips.last().unwrap();
+            assert!((last - tip).norm() < 1e-15, "t = {t}: {tips:?}");
+        }
     }
 
     /// A bond crossing a segment is cut; one touching only its tip is not; one through an

@@ -27,9 +27,11 @@ pub mod neighbors;
 pub mod operator;
 pub mod output;
 pub mod plot;
+pub mod reference;
 pub mod report;
 pub mod run;
 pub mod solve;
 pub mod spatial;
+pub mod sweep;
 
 pub use error::{Error, Result};

@@ -77,12 +77,50 @@ enum Command {
         run: PathBuf,
         /// Output directory of the reference run.
         reference: PathBuf,
+        /// Leave out the nodes within this distance (m) of a crack tip (e.g. 2δ).
+        #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
+        exclude_tips: f64,
     },
-    /// Draw a temperature map (PNG) of every output of a 2D run, cracks included, into the
-    /// run's directory as map_<k>.png.
+    /// Draw temperature maps (PNG and SVG) of every output of a 2D run, cracks included, into
+    /// the run's directory as map_<k>.png/.svg, and damage_<k>.png/.svg for runs with cracks.
     Plot {
         /// Output directory of `peritherm run`.
         run: PathBuf,
+    },
+    /// Run variants of one or more cases and compare each with a reference: writes every run
+    /// into --out/<variant>/, and sweep.csv and sweep.md (one row per variant and output time).
+    Sweep {
+        /// Case files (each is swept over the --vary values; several files are compared as
+        /// one study, e.g. the four (k, m) configurations of seed 004).
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// KEY=V1,V2,...: a dotted key of the case file and its values (array items by index,
+        /// or `*` for all: `region.*.horizon.factor=2,3,4,5`). Repeat for a product.
+        #[arg(long)]
+        vary: Vec<peritherm::sweep::Vary>,
+        /// Output directory (created if missing).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Compare with this finished run's fields instead of the cases' own [reference] (the
+        /// default when every case has one; otherwise the first variant).
+        #[arg(long, value_name = "RUN_DIR")]
+        against: Option<PathBuf>,
+        /// Leave out the nodes within this distance (m) of a crack tip in field comparisons.
+        #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
+        exclude_tips: f64,
+    },
+    /// Run cases and write reports: plots of PD against the reference along the probe lines,
+    /// the error along them, temperature/damage/flux maps, report.md and index.html.
+    Report {
+        /// Case files, or directories of case files.
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// Output directory: one subdirectory per case, and an index over several.
+        #[arg(long, short)]
+        out: PathBuf,
+        /// No progress lines.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Validate a case and print its size and stable time step without running it.
     Check {
@@ -230,8 +268,20 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Compare { run, reference } => compare(&run, &reference),
+        Command::Compare {
+            run,
+            reference,
+            exclude_tips,
+        } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
+        Command::Report { cases, out, quiet } => report(&cases, &out, quiet),
+        Command::Sweep {
+            cases,
+            vary,
+            out,
+            against,
+            exclude_tips,
+        } => sweep(&cases, &vary, &out, against, exclude_tips),
         Command::Check { case } => {
             let case = Case::load(&case)?;
             let model =
@@ -255,8 +305,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// `peritherm compare`: max and mean |Δθ| per output time, the reference interpolated at the
-/// run's nodes without looking across the run's cracks.
-fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result<()> {
+/// run's nodes without looking across the run's cracks; nodes within `exclude_tips` (m) of a
+/// crack tip are left out.
+fn compare(
+    run: &std::path::Path,
+    reference: &std::path::Path,
+    exclude_tips: f64,
+) -> anyhow::Result<()> {
     let a = RunSummary::read(run)?;
     let b = RunSummary::read(reference)?;
     let case = Case::load(std::path::Path::new(&a.case))?;
@@ -292,11 +347,13 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
         };
         let fa = read_field(&run.join(&a.fields[k]))?;
         let fb = read_field(&reference.join(&b.fields[kb]))?;
+        let tips = peritherm::crack::tips_at(&cracks, *t);
         let d = field_difference(
             cloud.dim,
             (&fa.pos, &fa.theta),
             (&fb.pos, &fb.theta),
             &cracks,
+            (&tips, exclude_tips),
         );
         say!(
             "| {t} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",
@@ -310,7 +367,70 @@ fn compare(run: &std::path::Path, reference: &std::path::Path) -> anyhow::Result
     Ok(())
 }
 
-/// `peritherm plot`: one temperature map per output, on a colour range shared by all of them.
+/// `peritherm sweep`: the variants of every case, run and compared; the table printed and
+/// written as sweep.csv and sweep.md.
+fn sweep(
+    cases: &[PathBuf],
+    vary: &[peritherm::sweep::Vary],
+    out: &std::path::Path,
+    against: Option<PathBuf>,
+    exclude_tips: f64,
+) -> anyhow::Result<()> {
+    use peritherm::sweep::{self, Against};
+    let mut variants = Vec::new();
+    for path in cases {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{}: cannot read", path.display()))?;
+        let prefix = if cases.len() > 1 {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
+        let mut v = sweep::variants(&text, path, &prefix, vary)?;
+        if v.len() == 1 && v[0].label.is_empty() {
+            v[0].label = "run".into();
+        }
+        variants.extend(v);
+    }
+    let against = match against {
+        Some(dir) => Against::Run(dir),
+        None if variants.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
+        None => Against::First,
+    };
+    let n = variants.len();
+    let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
+        eprintln!("[{}/{n}] {label}", k + 1);
+    })?;
+    let mut table = sweep::markdown(&rows);
+    let rates = sweep::convergence_plots(&rows, out)?;
+    let lines = sweep::line_plots(&variants, &rows, out, &against)?;
+    if !rates.is_empty() {
+        table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
+        for (stem, series, rate) in &rates {
+            table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
+        }
+    }
+    let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
+    plots.dedup();
+    plots.extend(lines.iter());
+    if !plots.is_empty() {
+        table.push('\n');
+        for p in plots {
+            table.push_str(&format!("![{p}]({p}.png)\n\n"));
+        }
+    }
+    peritherm::output::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
+    peritherm::output::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    say!("{table}");
+    say!("-> {}", out.join("sweep.md").display());
+    Ok(())
+}
+
+/// `peritherm plot`: per output a temperature map (one colour range for all outputs, cracks as
+/// they are at that time, region boundaries, flux arrows when the run has cracks) and, for runs
+/// with damage, a damage map; PNG and SVG.
 fn plot(run: &std::path::Path) -> anyhow::Result<()> {
     let summary = RunSummary::read(run)?;
     let case = Case::load(std::path::Path::new(&summary.case))?;
@@ -320,25 +440,61 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
             run.display()
         );
     }
-    let cloud = case.spec.geometry.bare_cloud()?;
-    let cutters = crack_cutters(&cloud, &case.spec.cracks);
     let fields = summary
         .fields
         .iter()
         .map(|f| read_field(&run.join(f)))
         .collect::<Result<Vec<_>, _>>()?;
-    let (lo, hi) = fields
-        .iter()
-        .flat_map(|f| f.theta.iter())
-        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
-    for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
-        let path = run.join(format!("map_{}.png", k + 1));
-        let cracks = peritherm::crack::segments_at(&cutters, *t);
-        peritherm::plot::temperature_map(&path, &f.pos, &f.theta, &f.spacing, (lo, hi), &cracks)?;
-        say!(
-            "t = {t} s: {} (blue {lo:.2} °C … white … red {hi:.2} °C)",
-            path.display()
-        );
+    for stem in peritherm::report::page::draw_maps(&case, &summary, &fields, run)? {
+        say!("{}.png/.svg", stem.display());
+    }
+    Ok(())
+}
+
+/// `peritherm report`: runs each case (directories: every case file in them) and writes its
+/// report into --out/<case>/; with several cases, one index over all of them.
+fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Result<()> {
+    use peritherm::case::ReferenceSource;
+    use peritherm::report::page::{write_index, write_report};
+    let mut cases = Vec::new();
+    for p in inputs {
+        if p.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(p)
+                .with_context(|| format!("{}: cannot list", p.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .collect();
+            found.sort();
+            cases.extend(found);
+        } else {
+            cases.push(p.clone());
+        }
+    }
+    let mut written = Vec::new();
+    for path in &cases {
+        let case = Case::load(path)?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "case".into());
+        let dir = out.join(&stem);
+        let run = dir.join("run");
+        if !quiet {
+            eprintln!("{}: running into {}", path.display(), run.display());
+        }
+        run_case(&case, &run, |_, _| {})?;
+        let reference = match case.reference.as_ref().map(|r| &r.source) {
+            Some(ReferenceSource::Analytic(_)) => "series",
+            Some(ReferenceSource::Table(_)) => "reference table",
+            None => "none",
+        };
+        let w = write_report(&case, &run, &dir, reference)?;
+        say!("{}: {}", path.display(), dir.join("index.html").display());
+        written.push(w);
+    }
+    if written.len() > 1 {
+        write_index(out, &written)?;
+        say!("index: {}", out.join("index.html").display());
     }
     Ok(())
 }

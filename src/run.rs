@@ -2,9 +2,10 @@
 
 use crate::case::Case;
 use crate::error::{Error, Result};
+use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
-use crate::report::compare;
+use crate::report::{classical_at, compare};
 use crate::solve::explicit::{choose_dt, count_steps, Explicit};
 use std::path::Path;
 use std::time::Instant;
@@ -41,6 +42,7 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let mut comparisons = Vec::new();
     let mut reference_seconds = 0.0;
     let t_run = Instant::now();
+    let cutters = crack_cutters(&model.cloud, &case.spec.cracks);
     let mut stepper = Explicit::new(&model, case.integrator);
     let stats = stepper.run(
         &mut theta,
@@ -52,10 +54,21 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
             let path = field_path(out, k + 1);
             let flux = conductance.flux(&model.cloud, th);
             let damage = model.damage_at(t);
+            let classical = match &case.reference {
+                Some(r) => {
+                    let started = Instant::now();
+                    let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                    comparisons.push(compare(&model.cloud, th, &classical, r, t));
+                    reference_seconds += started.elapsed().as_secs_f64();
+                    Some(classical)
+                }
+                None => None,
+            };
             let f = Fields {
                 theta: th,
                 damage: &damage,
                 flux: &flux,
+                reference: classical.as_deref(),
             };
             write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
             write_atomic(&vtu_path(out, k + 1), field_vtu(&model.cloud, &f).as_bytes())?;
@@ -65,11 +78,6 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
                     .to_string_lossy()
                     .into_owned(),
             );
-            if let Some(r) = &case.reference {
-                let started = Instant::now();
-                comparisons.push(compare(&model.cloud, th, r, t));
-                reference_seconds += started.elapsed().as_secs_f64();
-            }
             Ok(())
         },
         |s| progress(s, total),

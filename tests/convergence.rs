@@ -3,7 +3,7 @@
 
 use peritherm::case::Case;
 use peritherm::output::Comparison;
-use peritherm::report::compare;
+use peritherm::report::{classical_at, compare};
 use peritherm::run::run_case;
 use std::path::Path;
 
@@ -190,17 +190,12 @@ fn measures_follow_the_formulas() {
     );
     let model = peritherm::model::Model::build(&case.spec).unwrap();
     let r = case.reference.as_ref().unwrap();
-    let exact: Vec<f64> = model
-        .cloud
-        .pos
-        .iter()
-        .map(|p| r.solution.eval(p.x, 0.0, 1.0))
-        .collect();
+    let exact = classical_at(&model.cloud, &r.source, 1.0, &[]).unwrap();
     let pd: Vec<f64> = exact.iter().map(|e| e * 1.01).collect();
     let mut r = r.clone();
     r.line_y = None;
-    r.probe = Some(vec![5.4]);
-    let c = compare(&model.cloud, &pd, &r, 1.0);
+    r.probe = Some(peritherm::math::Point::new(5.4, 0.0, 0.0));
+    let c = compare(&model.cloud, &pd, &exact, &r, 1.0);
     let probe = c.probe.unwrap();
     assert!(
         (probe.x - 5.5).abs() < 1e-12 && (probe.peridynamic / probe.classical - 1.01).abs() < 1e-12

@@ -7,6 +7,9 @@ use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::PathBuf;
 
+mod common;
+use common::fd::CrackPlate;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -154,150 +157,72 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
     }
 }
 
-/// Temperature of the seed 003 Example 3 plate by finite differences: n × n cells on
-/// [−a, a]², 5-point stencil, the crack as removed face conductances between the rows on
-/// either side of y = 0 for |x| < c, held top and bottom faces (±100 °C), insulated sides.
-/// `transient = Some((α, Δt, steps))` takes backward Euler steps from θ0 = 0; None solves the
-/// steady state. Each system is solved by Jacobi-preconditioned conjugate gradients to 1e-10
-/// relative residual (an independent classical solver).
-fn fd_crack_plate(n: usize, a: f64, c: f64, transient: Option<(f64, f64, usize)>) -> Vec<f64> {
-    let h = 2.0 * a / n as f64;
-    let id = |i: usize, j: usize| j * n + i;
-    let x = |i: usize| -a + (i as f64 + 0.5) * h;
-    // conductance (× k) of the face between (i, j) and (i, j + 1)
-    let vertical = |i: usize, j: usize| -> f64 {
-        if j + 1 == n / 2 && x(i).abs() < c {
-            0.0
-        } else {
-            1.0
-        }
-    };
-    // shift = h²/(α Δt): the system of one step is (shift I + A) θ_new = shift θ_old + b
-    let (shift, steps) = match transient {
-        Some((alpha, dt, steps)) => (h * h / (alpha * dt), steps),
-        None => (0.0, 1),
-    };
-    let apply = |t: &[f64], out: &mut [f64]| {
-        for j in 0..n {
-            for i in 0..n {
-                let k = id(i, j);
-                let mut s = shift * t[k];
-                if i > 0 {
-                    s += t[k] - t[id(i - 1, j)];
-                }
-                if i + 1 < n {
-                    s += t[k] - t[id(i + 1, j)];
-                }
-                if j > 0 {
-                    s += vertical(i, j - 1) * (t[k] - t[id(i, j - 1)]);
-                }
-                if j + 1 < n {
-                    s += vertical(i, j) * (t[k] - t[id(i, j + 1)]);
-                }
-                if j == 0 || j + 1 == n {
-                    s += 2.0 * t[k];
-                }
-                out[k] = s;
-            }
-        }
-    };
-    let mut diag = vec![0.0; n * n];
-    let mut b = vec![0.0; n * n];
-    for j in 0..n {
-        for i in 0..n {
-            let k = id(i, j);
-            let mut d = shift + (i > 0) as u8 as f64 + (i + 1 < n) as u8 as f64;
-            if j > 0 {
-                d += vertical(i, j - 1);
-            }
-            if j + 1 < n {
-                d += vertical(i, j);
-            }
-            if j == 0 {
-                d += 2.0;
-                b[k] = 2.0 * -100.0;
-            }
-            if j + 1 == n {
-                d += 2.0;
-                b[k] = 2.0 * 100.0;
-            }
-            diag[k] = d;
-        }
-    }
-    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
-    let mut t = vec![0.0; n * n];
-    let (mut ap, mut rhs) = (vec![0.0; n * n], vec![0.0; n * n]);
-    for _ in 0..steps {
-        for k in 0..n * n {
-            rhs[k] = shift * t[k] + b[k];
-        }
-        apply(&t, &mut ap);
-        let mut r: Vec<f64> = rhs.iter().zip(&ap).map(|(f, a)| f - a).collect();
-        let mut z: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
-        let mut p = z.clone();
-        let mut rz = dot(&r, &z);
-        let norm = dot(&rhs, &rhs).sqrt();
-        for _ in 0..20 * n {
-            if dot(&r, &r).sqrt() < 1e-10 * norm {
-                break;
-            }
-            apply(&p, &mut ap);
-            let step = rz / dot(&p, &ap);
-            for k in 0..n * n {
-                t[k] += step * p[k];
-                r[k] -= step * ap[k];
-            }
-            for k in 0..n * n {
-                z[k] = r[k] / diag[k];
-            }
-            let rz_new = dot(&r, &z);
-            let beta = rz_new / rz;
-            rz = rz_new;
-            for k in 0..n * n {
-                p[k] = z[k] + beta * p[k];
-            }
-        }
-    }
-    t
-}
-
-/// The bundled seed 003 Example 3 crack plate (with the crack correction), run on to its
-/// steady state (3 s), agrees with the classical steady solution (finite differences, 3 × 3
-/// cells per PD node so that every node sits on a cell centre) within 1 °C at every node
-/// outside the 2δ discs around the crack tips. Measured 0.48 °C, the PD discretisation at
-/// δ = 13L/240 (without the crack correction: 2.22 °C, beside the crack faces). The flux is
-/// finite everywhere, damage is 0 far from the crack and positive beside it.
+/// The bundled seed 003 Example 3 crack plate (with the crack correction) against the
+/// classical solution of the same problem (finite differences on 3 × 3 cells per PD node, so
+/// that every node sits on a cell centre; `common::fd`), at every node outside the 2δ discs
+/// around the crack tips:
+/// - at 0.5 s against the classical transient at 0.5 s: within 1 °C (measured 0.45 °C);
+/// - run on to its steady state (3 s) against the classical steady solution: within 1 °C
+///   (measured 0.48 °C; without the crack correction 2.22 °C, beside the crack faces).
+///
+/// The 1 °C bound is about twice the PD discretisation error at δ = 13L/240 (seed 003's
+/// own figures show differences of this size against ABAQUS). The paper calls 0.5 s
+/// steady; it is not quite: the classical solution itself still moves by more than 2 °C
+/// between 0.5 s and its steady state at the middle of the crack faces, which this test also
+/// checks so that the transient-to-transient comparison stays justified.
 #[test]
 fn crack_plate_matches_finite_differences() {
     let mut c = Case::load(&root().join("cases/crack_plate.toml")).unwrap();
-    c.outputs = vec![3.0];
+    c.outputs = vec![0.5, 3.0];
     c.end = 3.0;
     let out = tempfile::tempdir().unwrap();
     peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
     let model = Model::build(&c.spec).unwrap();
-    let rows = peritherm::output::read_field(&out.path().join("field_1.csv")).unwrap();
-    let (pos, theta) = (rows.pos, rows.theta);
-    let n = 360;
-    let fd = fd_crack_plate(n, 0.01, 0.005, None);
-    let h = 0.02 / n as f64;
+    let plate = CrackPlate {
+        n: 360,
+        a: 0.01,
+        c: 0.005,
+        theta_top: 100.0,
+    };
+    let alpha = 114.0 / 1e6;
+    let transient = plate.transient(alpha, 1e-3, 0.5);
+    let steady = plate.steady();
     let delta = 13.0 * 0.02 / 240.0;
-    let mut worst: f64 = 0.0;
-    for (p, t) in pos.iter().zip(&theta) {
-        let near_tip = [-0.005, 0.005]
-            .iter()
-            .any(|tx| (p.x - tx).hypot(p.y) < 2.0 * delta);
-        if near_tip {
-            continue;
+    let worst = |field: &str, fd: &[f64]| {
+        let rows = peritherm::output::read_field(&out.path().join(field)).unwrap();
+        let mut worst: f64 = 0.0;
+        for (p, t) in rows.pos.iter().zip(&rows.theta) {
+            let near_tip = [-0.005, 0.005]
+                .iter()
+                .any(|tx| (p.x - tx).hypot(p.y) < 2.0 * delta);
+            if !near_tip {
+                worst = worst.max((t - plate.at(fd, p.x, p.y)).abs());
+            }
         }
-        let i = ((p.x + 0.01) / h - 0.5).round() as usize;
-        let j = ((p.y + 0.01) / h - 0.5).round() as usize;
-        worst = worst.max((t - fd[j * n + i]).abs());
-    }
-    eprintln!("crack plate: max |θ_PD − θ_FD| outside the tip discs = {worst:.3} °C");
-    assert!(worst < 1.0, "max difference {worst} °C");
+        worst
+    };
+    let moved = transient
+        .iter()
+        .zip(&steady)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let (at_half, at_steady) = (
+        worst("field_1.csv", &transient),
+        worst("field_2.csv", &steady),
+    );
+    eprintln!(
+        "crack plate, max |θ_PD − θ_FD| outside the tip discs: {at_half:.3} °C at 0.5 s, \
+         {at_steady:.3} °C steady; the classical field moves {moved:.2} °C after 0.5 s"
+    );
+    assert!(at_half < 1.0, "at 0.5 s: max difference {at_half} °C");
+    assert!(at_steady < 1.0, "steady: max difference {at_steady} °C");
+    assert!(
+        moved > 2.0,
+        "the classical field moves {moved} °C after 0.5 s"
+    );
     // the heat flux (columns qx, qy) is finite everywhere and at the tips a few times the
     // far-field flux k·200 °C/2 cm = 1.14e6 W/m² (measured: 3.9e6 at the node by the tip)
-    let text = std::fs::read_to_string(out.path().join("field_1.csv")).unwrap();
+    let text = std::fs::read_to_string(out.path().join("field_2.csv")).unwrap();
     let mut tip_flux: f64 = 0.0;
     for line in text.lines().skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
@@ -456,4 +381,61 @@ end = 1.0
         .unwrap_err()
         .to_string();
     assert!(e.contains("crack[0].points") && e.contains("planar"), "{e}");
+}
+
+/// Seed 004 §4.3: the dual-horizon crack plate with a coarse outer region ((k, m) = (2, 1),
+/// 25000 nodes) agrees with the classical solution at 0.5 s (finite differences, bilinear
+/// between cell centres, never across the crack) as well as the uniform fine run ((1, 1),
+/// 40000 nodes) does, outside the 2δ discs around the crack tips: both within 1 °C
+/// (measured 0.38 and 0.37 °C, the PD discretisation at δ = 3Δ beside the crack faces; the
+/// bound is the one of `crack_plate_matches_finite_differences`), and within 0.2 °C of each
+/// other (measured 0.09 °C, at the region interface).
+#[test]
+fn dual_horizon_crack_plate_matches_finite_differences() {
+    let plate = CrackPlate {
+        n: 360,
+        a: 0.01,
+        c: 0.005,
+        theta_top: 100.0,
+    };
+    let fd = plate.transient(114.0 / 1e6, 1e-3, 0.5);
+    let two_delta = 2.0 * 3.0 * 1e-4;
+    let mut fields = Vec::new();
+    for name in ["dh_crack_plate_k2_m1", "dh_crack_plate_k1_m1"] {
+        let mut c = Case::load(&root().join(format!("cases/{name}.toml"))).unwrap();
+        c.outputs = vec![0.5];
+        let out = tempfile::tempdir().unwrap();
+        let s = peritherm::run::run_case(&c, out.path(), |_, _| {}).unwrap();
+        let rows = peritherm::output::read_field(&out.path().join("field_1.csv")).unwrap();
+        let mut worst: f64 = 0.0;
+        for (p, t) in rows.pos.iter().zip(&rows.theta) {
+            let near_tip = [-0.005, 0.005]
+                .iter()
+                .any(|tx| (p.x - tx).hypot(p.y) < two_delta);
+            if !near_tip {
+                worst = worst.max((t - plate.interpolate(&fd, p.x, p.y)).abs());
+            }
+        }
+        eprintln!(
+            "{name}: {} nodes, max |θ_PD − θ_FD| = {worst:.3} °C",
+            s.nodes
+        );
+        assert!(worst < 1.0, "{name}: max difference {worst} °C");
+        fields.push((s.nodes, rows, c));
+    }
+    let (coarse, fine) = (&fields[0], &fields[1]);
+    assert!(coarse.0 < fine.0);
+    let cloud = fine.2.spec.geometry.bare_cloud().unwrap();
+    let cracks = peritherm::model::crack_cutters(&cloud, &fine.2.spec.cracks);
+    let tips = peritherm::crack::tips_at(&cracks, 0.5);
+    assert_eq!(tips.len(), 2);
+    let d = peritherm::report::field_difference(
+        2,
+        (&coarse.1.pos, &coarse.1.theta),
+        (&fine.1.pos, &fine.1.theta),
+        &cracks,
+        (&tips, two_delta),
+    );
+    eprintln!("(2, 1) against (1, 1): max {:.3} °C", d.max_abs);
+    assert!(d.max_abs < 0.2, "(2, 1) against (1, 1): {} °C", d.max_abs);
 }

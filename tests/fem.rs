@@ -5,8 +5,9 @@
 //! `cargo test --release --test fem -- --nocapture` prints the measured figures quoted in the
 //! README.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
+mod common;
+
+use common::fd::CrackPlate;
 use peritherm::case::Case;
 use peritherm::fem::run::FemModel;
 use peritherm::fem::shape::shape;
@@ -21,6 +22,14 @@ fn root() -> PathBuf {
 
 fn case(text: &str) -> Case {
     Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The case's analytical reference series.
+fn analytic(c: &Case) -> &peritherm::analytic::Reference {
+    match &c.reference.as_ref().expect("a reference").source {
+        peritherm::case::ReferenceSource::Analytic(r) => r,
+        _ => panic!("not an analytical reference"),
+    }
 }
 
 /// Integrates `model` from 0 to `end` in `n` equal steps of `scheme`.
@@ -39,7 +48,7 @@ fn integrate(model: &FemModel, scheme: Scheme, end: f64, n: usize) -> Vec<f64> {
 fn max_error(c: &Case, h: f64, end: f64, n: usize) -> f64 {
     let model = FemModel::build(c, Some(h)).unwrap();
     let theta = integrate(&model, Scheme::CrankNicolson, end, n);
-    let r = &c.reference.as_ref().unwrap().solution;
+    let r = analytic(c);
     let pts: Vec<(f64, f64)> = model.mesh.nodes.iter().map(|p| (p.x, p.y)).collect();
     let exact = r.eval_many(&pts, end);
     theta
@@ -173,66 +182,22 @@ fn bar_converges_at_second_order() {
     );
 }
 
-/// The seed 003 Example 3 plate by finite differences: n × n cells on [−a, a]², 5-point
-/// stencil, the crack as removed face conductances between the rows either side of y = 0 for
-/// |x| < c, top and bottom faces held at ±100 °C (ghost cells), sides insulated. `steps`
-/// backward-Euler steps of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when
-/// `steps` = 0. Written for this test with faer's sparse Cholesky (independent of src/fem/).
+/// The seed 003 Example 3 plate by the finite differences of tests/common/fd.rs (n × n cells
+/// on [−a, a]², crack |x| < c on y = 0, ±100 °C top and bottom): `steps` backward-Euler steps
+/// of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when `steps` = 0. Cells
+/// row by row.
 fn fd_plate(n: usize, a: f64, c: f64, alpha: f64, dt: f64, steps: usize) -> Vec<f64> {
-    let h = 2.0 * a / n as f64;
-    let id = |i: usize, j: usize| j * n + i;
-    let x = |i: usize| -a + (i as f64 + 0.5) * h;
-    let shift = if steps == 0 {
-        0.0
-    } else {
-        h * h / (alpha * dt)
+    let plate = CrackPlate {
+        n,
+        a,
+        c,
+        theta_top: 100.0,
     };
-    let mut trip = Vec::new();
-    let mut b = vec![0.0; n * n];
-    for j in 0..n {
-        for i in 0..n {
-            let k = id(i, j);
-            let mut d = shift;
-            let mut link = |kk: usize, g: f64, d: &mut f64| {
-                *d += g;
-                if kk < k && g > 0.0 {
-                    trip.push(Triplet::new(k, kk, -g));
-                }
-            };
-            if i > 0 {
-                link(id(i - 1, j), 1.0, &mut d);
-            }
-            if i + 1 < n {
-                link(id(i + 1, j), 1.0, &mut d);
-            }
-            let cut = |jj: usize| jj + 1 == n / 2 && x(i).abs() < c;
-            if j > 0 {
-                link(id(i, j - 1), if cut(j - 1) { 0.0 } else { 1.0 }, &mut d);
-            }
-            if j + 1 < n {
-                link(id(i, j + 1), if cut(j) { 0.0 } else { 1.0 }, &mut d);
-            }
-            if j == 0 {
-                d += 2.0;
-                b[k] = -200.0;
-            }
-            if j + 1 == n {
-                d += 2.0;
-                b[k] = 200.0;
-            }
-            trip.push(Triplet::new(k, k, d));
-        }
+    if steps == 0 {
+        plate.steady()
+    } else {
+        plate.transient(alpha, dt, steps as f64 * dt)
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n * n, n * n, &trip).unwrap();
-    let llt = a.sp_cholesky(faer::Side::Lower).unwrap();
-    let mut t = vec![0.0; n * n];
-    for _ in 0..steps.max(1) {
-        for k in 0..n * n {
-            t[k] = shift * t[k] + b[k];
-        }
-        llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut t, n * n, 1));
-    }
-    t
 }
 
 /// The FEM field of a box case on a uniform grid of `nx` × `nx` quads at points (x, y): the
@@ -254,7 +219,7 @@ fn fem_at(model: &FemModel, theta: &[f64], nx: usize, a: f64, x: f64, y: f64) ->
 /// Seed 003 Example 3 (the bundled `cases/crack_plate.toml`: 2 × 2 cm, ±100 °C top and
 /// bottom, insulated sides and crack y = 0, |x| ≤ 0.5 cm, α = 1.14 cm²/s) by FEM on
 /// 200 × 200 bilinear quads (h = 0.1 mm; the crack's 99 interior nodes duplicated, the tips
-/// shared) against the finite differences above on 480 × 480 cells (h = 41.7 µm), compared at
+/// shared) against the finite differences of tests/common/fd.rs on 480 × 480 cells (h = 41.7 µm), compared at
 /// the FD cell centres of every other row and column (the FEM field interpolated in its quad,
 /// which never straddles the crack): the steady states, and the transient at 0.5 s from θ0 = 0
 /// with the same 200 backward-Euler steps in both (the time error is shared).
@@ -461,7 +426,7 @@ fn write_case(dir: &Path, text: &str) -> String {
 }
 
 /// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header
-/// and one row per FEM node, field_<k>.vtu, and a run.json (solver "fem", the reference
+/// (the reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver "fem", the reference
 /// comparison) that `peritherm table` reads.
 #[test]
 fn cli_writes_the_run_contract() {
@@ -487,9 +452,10 @@ fn cli_writes_the_run_contract() {
     for k in 1..=2 {
         let text = std::fs::read_to_string(out.join(format!("field_{k}.csv"))).unwrap();
         let mut lines = text.lines();
+        // the case has an analytical reference, so its value at each node is the last column
         assert_eq!(
             lines.next().unwrap(),
-            "x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz"
+            "x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz,reference"
         );
         assert_eq!(lines.count(), 17 * 17);
         assert!(out.join(format!("field_{k}.vtu")).exists());
@@ -835,7 +801,7 @@ end = 0.1
 fn crank_nicolson_start_damps_the_initial_jump() {
     let c = case(SQUARE);
     let model = FemModel::build(&c, Some(1.0 / 32.0)).unwrap();
-    let r = &c.reference.as_ref().unwrap().solution;
+    let r = analytic(&c);
     let pts: Vec<(f64, f64)> = model.mesh.nodes.iter().map(|p| (p.x, p.y)).collect();
     let exact = r.eval_many(&pts, 0.02);
     let err = |scheme| {

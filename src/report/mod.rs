@@ -1,26 +1,76 @@
-//! Measures that compare a run with a classical solution (formulation §9).
+//! Measures that compare a run with a classical solution (formulation §9), and the report
+//! pages that show them ([`page`]).
 
-use crate::case::ReferenceSpec;
+pub mod page;
+
+use crate::case::{ReferenceSource, ReferenceSpec};
 use crate::cloud::Cloud;
 use crate::crack::Cutter;
+use crate::error::{Error, Result};
 use crate::math::Point;
 use crate::output::{Comparison, Probe};
+use crate::reference::covered_box;
 use crate::spatial::PointIndex;
 use rayon::prelude::*;
 
-/// Compares the body temperatures with the case's reference at time `t`: over all nodes,
-/// along the probe line y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the
-/// body node nearest to `probe`.
-pub fn compare(cloud: &Cloud, theta: &[f64], spec: &ReferenceSpec, t: f64) -> Comparison {
-    let reference = &spec.solution;
+/// The classical temperatures at the body nodes of `cloud` at time `t`, °C: the analytical
+/// series evaluated there, or the reference table interpolated (linear least squares over its
+/// nearest points, never across `cracks`; see [`field_difference`]). A table that does not
+/// cover every node is an error naming it.
+pub fn classical_at(
+    cloud: &Cloud,
+    source: &ReferenceSource,
+    t: f64,
+    cracks: &[Cutter],
+) -> Result<Vec<f64>> {
+    let nodes = &cloud.pos[..cloud.n_body];
+    match source {
+        ReferenceSource::Analytic(r) => {
+            let points: Vec<(f64, f64)> = nodes.iter().map(|p| (p.x, p.y)).collect();
+            Ok(r.eval_many(&points, t))
+        }
+        ReferenceSource::Table(table) => {
+            let bad = |message: String| Error::Case {
+                file: table.path.clone(),
+                key: format!("t = {t}"),
+                message,
+            };
+            let snap = table
+                .at(t)
+                .ok_or_else(|| bad("no rows at this output time".into()))?;
+            let (lo, hi) = covered_box(&snap.pos, cloud.dim);
+            if let Some(p) = nodes
+                .iter()
+                .find(|p| (0..cloud.dim).any(|a| p[a] < lo[a] || p[a] > hi[a]))
+            {
+                return Err(bad(format!(
+                    "does not cover the node at ({}, {}, {}) m: its points span ({}, {}, {}) to ({}, {}, {}) m",
+                    p.x, p.y, p.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+                )));
+            }
+            let index = PointIndex::new(&snap.pos);
+            Ok(nodes
+                .par_iter()
+                .map(|x| interpolate(cloud.dim, &index, (&snap.pos, &snap.theta), x, cracks))
+                .collect())
+        }
+    }
+}
+
+/// Compares the body temperatures `theta` with the classical ones `classical` (at the body
+/// nodes, from [`classical_at`]) at time `t`: over all nodes, along the probe line
+/// y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the body node nearest to
+/// the probe point.
+pub fn compare(
+    cloud: &Cloud,
+    theta: &[f64],
+    classical: &[f64],
+    spec: &ReferenceSpec,
+    t: f64,
+) -> Comparison {
     let line_y = spec.line_y;
     let n = cloud.n_body;
-    let probe = spec.probe.as_ref().and_then(|c| {
-        let target = Point::new(
-            c.first().copied().unwrap_or(0.0),
-            c.get(1).copied().unwrap_or(0.0),
-            c.get(2).copied().unwrap_or(0.0),
-        );
+    let probe = spec.probe.and_then(|target| {
         let i = (0..n).min_by(|&a, &b| {
             let da = (cloud.pos[a] - target).norm();
             let db = (cloud.pos[b] - target).norm();
@@ -31,11 +81,9 @@ pub fn compare(cloud: &Cloud, theta: &[f64], spec: &ReferenceSpec, t: f64) -> Co
             x: p.x,
             y: p.y,
             peridynamic: theta[i],
-            classical: reference.eval(p.x, p.y, t),
+            classical: classical[i],
         })
     });
-    let points: Vec<(f64, f64)> = cloud.pos[..n].iter().map(|p| (p.x, p.y)).collect();
-    let classical = reference.eval_many(&points, t);
     let mut max_abs: f64 = 0.0;
     let (mut sq_rel, mut n_rel) = (0.0, 0usize);
     let (mut sq, mut cmax) = (0.0, 0.0f64);
@@ -92,26 +140,24 @@ pub struct FieldDifference {
 
 /// Compares field A with a reference field B: B is interpolated at each node of A by a
 /// linear least-squares fit over B's 8 (3D: 12) nearest nodes that A's node sees without
-/// crossing a crack (first-order exact: a linear field interpolates without error).
+/// crossing a crack (first-order exact: a linear field interpolates without error). Nodes of
+/// A within `exclude.1` (m) of any point of `exclude.0` (e.g. crack tips) are left out.
 pub fn field_difference(
     dim: usize,
     a: (&[Point], &[f64]),
     b: (&[Point], &[f64]),
     cracks: &[Cutter],
+    exclude: (&[Point], f64),
 ) -> FieldDifference {
     let index = PointIndex::new(b.0);
-    let k = if dim == 3 { 12 } else { 8 };
     let per_node: Vec<f64> =
         a.0.par_iter()
             .zip(a.1.par_iter())
             .map(|(x, &ta)| {
-                let near: Vec<(usize, f64)> = index
-                    .nearest(x, 4 * k)
-                    .into_iter()
-                    .filter(|(j, _)| !cracks.iter().any(|c| c.cuts(x, &b.0[*j])))
-                    .take(k)
-                    .collect();
-                (ta - fit_at(dim, x, &near, b)).abs()
+                if exclude.0.iter().any(|c| (x - c).norm() < exclude.1) {
+                    return f64::NAN;
+                }
+                (ta - interpolate(dim, &index, b, x, cracks)).abs()
             })
             .collect();
     let (imax, max_abs) = per_node
@@ -119,11 +165,31 @@ pub fn field_difference(
         .copied()
         .enumerate()
         .fold((0, 0.0), |m, (i, d)| if d > m.1 { (i, d) } else { m });
+    let kept: Vec<f64> = per_node.into_iter().filter(|d| !d.is_nan()).collect();
     FieldDifference {
         max_abs,
-        mean_abs: per_node.iter().sum::<f64>() / per_node.len().max(1) as f64,
+        mean_abs: kept.iter().sum::<f64>() / kept.len().max(1) as f64,
         at: a.0.get(imax).copied().unwrap_or_else(Point::origin),
     }
+}
+
+/// Value of field `b` at `x`: the linear least-squares fit over its 8 (3D: 12) nearest points
+/// that `x` sees without crossing a crack.
+fn interpolate(
+    dim: usize,
+    index: &PointIndex,
+    b: (&[Point], &[f64]),
+    x: &Point,
+    cracks: &[Cutter],
+) -> f64 {
+    let k = if dim == 3 { 12 } else { 8 };
+    let near: Vec<(usize, f64)> = index
+        .nearest(x, 4 * k)
+        .into_iter()
+        .filter(|(j, _)| !cracks.iter().any(|c| c.cuts(x, &b.0[*j])))
+        .take(k)
+        .collect();
+    fit_at(dim, x, &near, b)
 }
 
 /// Value at `x` of the weighted linear least-squares fit through the points `near` of `b`

@@ -1,0 +1,699 @@
+//! Sweeps: variants of cases (over the horizon factor, the spacing, the mesh ratio k, the
+//! horizon ratio m, …) made by setting keys of the case file, run one after another, and
+//! compared with a reference (formulation §9): the case's own `[reference]`, another run, or
+//! the first variant.
+
+use crate::case::Case;
+use crate::crack::tips_at;
+use crate::error::{Error, Result};
+use crate::model::crack_cutters;
+use crate::output::{read_field, RunSummary};
+use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
+use crate::report::field_difference;
+use crate::report::page::probe_lines;
+use crate::run::run_case;
+use std::path::{Path, PathBuf};
+
+/// One `--vary KEY=V1,V2,…`: a dotted key of the case file and the values it takes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vary {
+    /// Dotted key; array items by index (`region.0.spacing`) or all of them (`region.*.spacing`).
+    pub key: String,
+    /// Values as TOML text (numbers, strings, inline arrays or tables).
+    pub values: Vec<String>,
+}
+
+impl std::str::FromStr for Vary {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Vary, String> {
+        let (key, values) = s
+            .split_once('=')
+            .ok_or_else(|| format!("`{s}`: expected KEY=V1,V2,..."))?;
+        let values = split_values(values);
+        if key.trim().is_empty() || values.iter().any(String::is_empty) || values.is_empty() {
+            return Err(format!("`{s}`: expected KEY=V1,V2,... with no empty value"));
+        }
+        Ok(Vary {
+            key: key.trim().to_string(),
+            values,
+        })
+    }
+}
+
+/// Splits `a,b,[c,d],{e=1,f=2}` at the commas outside brackets and braces.
+fn split_values(s: &str) -> Vec<String> {
+    let (mut out, mut cur, mut depth) = (Vec::new(), String::new(), 0i32);
+    for ch in s.chars() {
+        match ch {
+            '[' | '{' => depth += 1,
+            ']' | '}' => depth -= 1,
+            ',' if depth == 0 => {
+                out.push(cur.trim().to_string());
+                cur.clear();
+                continue;
+            }
+            _ => {}
+        }
+        cur.push(ch);
+    }
+    out.push(cur.trim().to_string());
+    out
+}
+
+/// A case with some keys set: its label, the settings and the validated case.
+#[derive(Debug, Clone)]
+pub struct Variant {
+    /// Short name, also its output directory's name.
+    pub label: String,
+    /// The keys set, as (key, value text).
+    pub settings: Vec<(String, String)>,
+    /// The case with the settings applied (its path is the original file's).
+    pub case: Case,
+}
+
+/// All variants of the case file `path` (text `text`): the Cartesian product of `vary`, in
+/// order (the last key varies fastest). Labels start with `prefix`.
+pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<Vec<Variant>> {
+    let err = |key: &str, message: String| Error::Case {
+        file: path.to_path_buf(),
+        key: key.to_string(),
+        message,
+    };
+    let base: toml::Table = toml::from_str(text).map_err(|e| {
+        err(
+            "-",
+            format!("not a TOML table: {}", e.message().replace('\n', " ")),
+        )
+    })?;
+    let mut combos: Vec<Vec<(String, String)>> = vec![Vec::new()];
+    for v in vary {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                v.values.iter().map(move |x| {
+                    let mut c = c.clone();
+                    c.push((v.key.clone(), x.clone()));
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+        .into_iter()
+        .map(|settings| {
+            let mut table = base.clone();
+            for (key, value) in &settings {
+                set(&mut table, key, value).map_err(|m| err(key, m))?;
+            }
+            let text = toml::to_string(&table).expect("a TOML table serialises");
+            let case = Case::parse(&text, path).map_err(|e| match e {
+                // line numbers of the rewritten text mean nothing to the user: name the settings
+                Error::Case { key, message, .. } => {
+                    let set: Vec<String> =
+                        settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
+                    let at = if key.starts_with("line ") {
+                        String::new()
+                    } else {
+                        format!(" ({key})")
+                    };
+                    err(
+                        &format!("--vary {}", set.join(" ")),
+                        format!("{message}{at}"),
+                    )
+                }
+                other => other,
+            })?;
+            let label = label(prefix, &settings);
+            Ok(Variant {
+                label,
+                settings,
+                case,
+            })
+        })
+        .collect()
+}
+
+/// `prefix` plus `last-key-segment=value` for each setting, made safe for a directory name.
+fn label(prefix: &str, settings: &[(String, String)]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    if !prefix.is_empty() {
+        parts.push(prefix.to_string());
+    }
+    for (k, v) in settings {
+        let short = k.rsplit('.').next().unwrap_or(k);
+        parts.push(format!("{short}={v}"));
+    }
+    let raw = parts.join("_");
+    raw.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._=-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Parses a value's TOML text; a bare word that is not TOML is a string. An integer where
+/// the file has a float becomes a float.
+fn parse_value(text: &str, old: Option<&toml::Value>) -> toml::Value {
+    let parsed = toml::from_str::<toml::Table>(&format!("v = {text}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(text.to_string()));
+    match (parsed, old) {
+        (toml::Value::Integer(i), Some(toml::Value::Float(_))) => toml::Value::Float(i as f64),
+        (v, _) => v,
+    }
+}
+
+/// Sets the dotted `key` of `table` to `value` (TOML text). Every segment but the last must
+/// exist; `*` applies the rest of the key to every item of an array.
+fn set(table: &mut toml::Table, key: &str, value: &str) -> std::result::Result<(), String> {
+    let parts: Vec<&str> = key.split('.').collect();
+    let mut root = toml::Value::Table(std::mem::take(table));
+    let r = set_in(&mut root, &parts, value, key);
+    if let toml::Value::Table(t) = root {
+        *table = t;
+    }
+    r
+}
+
+fn set_in(
+    node: &mut toml::Value,
+    parts: &[&str],
+    value: &str,
+    key: &str,
+) -> std::result::Result<(), String> {
+    let missing = || format!("no such key in the case file (`{key}`)");
+    let (head, rest) = parts.split_first().ok_or_else(missing)?;
+    match node {
+        toml::Value::Table(t) => {
+            if rest.is_empty() {
+                let v = parse_value(value, t.get(*head));
+                t.insert(head.to_string(), v);
+                return Ok(());
+            }
+            set_in(t.get_mut(*head).ok_or_else(missing)?, rest, value, key)
+        }
+        toml::Value::Array(items) => {
+            let targets: Vec<usize> = if *head == "*" {
+                (0..items.len()).collect()
+            } else {
+                vec![head.parse::<usize>().map_err(|_| missing())?]
+            };
+            for i in targets {
+                let item = items.get_mut(i).ok_or_else(missing)?;
+                if rest.is_empty() {
+                    *item = parse_value(value, Some(item));
+                } else {
+                    set_in(item, rest, value, key)?;
+                }
+            }
+            Ok(())
+        }
+        _ => Err(missing()),
+    }
+}
+
+/// One row of a sweep's table: a variant at one output time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// Variant label.
+    pub label: String,
+    /// The keys set, as (key, value text).
+    pub settings: Vec<(String, String)>,
+    /// Body nodes.
+    pub nodes: usize,
+    /// Directed bonds.
+    pub bonds: usize,
+    /// Time steps.
+    pub steps: u64,
+    /// Seconds of set-up plus integration.
+    pub wall_seconds: f64,
+    /// Smallest horizon δ of the body, m.
+    pub delta_min: f64,
+    /// δ/Δ at the node with the smallest horizon.
+    pub ratio: f64,
+    /// Output time, s.
+    pub time: f64,
+    /// max |θ − θ_ref| over the body nodes compared, °C.
+    pub max_abs: f64,
+    /// Mean |θ − θ_ref| over the nodes compared, °C (field-to-field comparisons only).
+    pub mean_abs: Option<f64>,
+    /// Seed 003 eq 13 along the case's probe line (classical references only).
+    pub eq13: Option<f64>,
+    /// Seed 001 eq 27 (classical references only).
+    pub epsilon: Option<f64>,
+    /// What it is compared with.
+    pub against: String,
+}
+
+/// The CSV table of a sweep: one line per row, the varied keys as columns.
+pub fn csv(rows: &[Row]) -> String {
+    let keys: Vec<String> = rows
+        .first()
+        .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
+    let mut s = String::from("variant,");
+    for k in &keys {
+        s.push_str(k);
+        s.push(',');
+    }
+    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,time,max_abs,mean_abs,eq13,epsilon,against\n");
+    for r in rows {
+        s.push_str(&r.label);
+        s.push(',');
+        for (_, v) in &r.settings {
+            s.push_str(&v.replace(',', ";"));
+            s.push(',');
+        }
+        s.push_str(&format!(
+            "{},{},{},{:.3},{:e},{},{},{:e},{},{},{},{}\n",
+            r.nodes,
+            r.bonds,
+            r.steps,
+            r.wall_seconds,
+            r.delta_min,
+            r.ratio,
+            r.time,
+            r.max_abs,
+            opt(r.mean_abs),
+            opt(r.eq13),
+            opt(r.epsilon),
+            r.against
+        ));
+    }
+    s
+}
+
+/// The Markdown table of a sweep.
+pub fn markdown(rows: &[Row]) -> String {
+    let keys: Vec<String> = rows
+        .first()
+        .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    let mut s = String::from("| variant |");
+    for k in &keys {
+        s.push_str(&format!(" {k} |"));
+    }
+    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | against |\n|---|");
+    for _ in &keys {
+        s.push_str("---|");
+    }
+    s.push_str("---|---|---|---|---|---|---|---|---|---|---|\n");
+    let opt = |v: Option<f64>| v.map(|x| format!("{x:.3e}")).unwrap_or_else(|| "-".into());
+    for r in rows {
+        s.push_str(&format!("| {} |", r.label));
+        for (_, v) in &r.settings {
+            s.push_str(&format!(" {v} |"));
+        }
+        s.push_str(&format!(
+            " {} | {} | {:.3e} | {:.3} | {:.1} | {} | {:.3e} | {} | {} | {} | {} |\n",
+            r.nodes,
+            r.bonds,
+            r.delta_min,
+            r.ratio,
+            r.wall_seconds,
+            r.time,
+            r.max_abs,
+            opt(r.mean_abs),
+            opt(r.eq13),
+            opt(r.epsilon),
+            r.against
+        ));
+    }
+    s
+}
+
+/// What the variants of a sweep are compared with.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Against {
+    /// Each variant's own `[reference]` (all must have one).
+    Reference,
+    /// The fields of a finished run (e.g. a fine uniform PD run or `peritherm fem`).
+    Run(PathBuf),
+    /// The fields of the first variant.
+    First,
+}
+
+/// Runs every variant into `out/<label>/` and compares it with `against` at each of its
+/// output times; nodes within `exclude_tips` (m) of a crack tip are left out of field-to-field
+/// comparisons. `progress(k, label)` is called before variant k runs.
+pub fn run(
+    variants: &[Variant],
+    out: &Path,
+    against: &Against,
+    exclude_tips: f64,
+    mut progress: impl FnMut(usize, &str),
+) -> Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    for (k, v) in variants.iter().enumerate() {
+        progress(k, &v.label);
+        let dir = out.join(&v.label);
+        let summary = run_case(&v.case, &dir, |_, _| {})?;
+        let cloud = v.case.spec.geometry.bare_cloud()?;
+        let finest = (0..cloud.n_body)
+            .min_by(|&a, &b| cloud.horizon[a].total_cmp(&cloud.horizon[b]))
+            .unwrap_or(0);
+        let base = Row {
+            label: v.label.clone(),
+            settings: v.settings.clone(),
+            nodes: summary.nodes,
+            bonds: summary.bonds,
+            steps: summary.steps,
+            wall_seconds: summary.setup_seconds + summary.wall_seconds,
+            delta_min: cloud.horizon[finest],
+            ratio: cloud.horizon[finest] / cloud.spacing[finest],
+            time: 0.0,
+            max_abs: 0.0,
+            mean_abs: None,
+            eq13: None,
+            epsilon: None,
+            against: String::new(),
+        };
+        let reference_dir = match against {
+            Against::Reference => {
+                if summary.reference.is_empty() {
+                    return Err(Error::Case {
+                        file: v.case.path.clone(),
+                        key: "reference".into(),
+                        message:
+                            "the case has no [reference]; give the sweep a run to compare with"
+                                .into(),
+                    });
+                }
+                for c in &summary.reference {
+                    rows.push(Row {
+                        time: c.time,
+                        max_abs: c.max_abs_diff,
+                        eq13: Some(c.l2_rel_line),
+                        epsilon: Some(c.epsilon),
+                        against: "reference".into(),
+                        ..base.clone()
+                    });
+                }
+                continue;
+            }
+            Against::Run(d) => d.clone(),
+            Against::First => out.join(&variants[0].label),
+        };
+        let reference = RunSummary::read(&reference_dir)?;
+        let cracks = crack_cutters(&cloud, &v.case.spec.cracks);
+        for (i, t) in summary.output_times.iter().enumerate() {
+            let Some(j) = reference
+                .output_times
+                .iter()
+                .position(|r| (r - t).abs() <= 1e-9 * t.abs())
+            else {
+                return Err(Error::Case {
+                    file: reference_dir.join("run.json"),
+                    key: "output_times".into(),
+                    message: format!("has no output at t = {t} s, which {} writes", v.label),
+                });
+            };
+            let a = read_field(&dir.join(&summary.fields[i]))?;
+            let b = read_field(&reference_dir.join(&reference.fields[j]))?;
+            let tips = tips_at(&cracks, *t);
+            let d = field_difference(
+                cloud.dim,
+                (&a.pos, &a.theta),
+                (&b.pos, &b.theta),
+                &cracks,
+                (&tips, exclude_tips),
+            );
+            rows.push(Row {
+                time: *t,
+                max_abs: d.max_abs,
+                mean_abs: Some(d.mean_abs),
+                against: reference_dir.display().to_string(),
+                ..base.clone()
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
+/// eq 13 where there is one) against each varied key whose values are positive numbers, and
+/// against the smallest horizon δ when it varies, on log–log axes with fitted rates (seed 000
+/// Figs 10–12, seed 003 Figs 11–12). Returns the stems written and the fitted rates as
+/// (stem, series, rate).
+pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+    let mut axes: Vec<(String, Box<dyn Fn(&Row) -> Option<f64>>)> = Vec::new();
+    let keys: Vec<String> = rows
+        .first()
+        .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    for (i, k) in keys.iter().enumerate() {
+        axes.push((
+            k.clone(),
+            Box::new(move |r: &Row| r.settings[i].1.parse::<f64>().ok().filter(|v| *v > 0.0)),
+        ));
+    }
+    // δ_min unless it is proportional to a varied key (the same plot again)
+    let proportional = |i: usize| {
+        let ratios: Vec<f64> = rows
+            .iter()
+            .filter_map(|r| Some(r.settings[i].1.parse::<f64>().ok()? / r.delta_min))
+            .collect();
+        ratios.len() == rows.len() && ratios.iter().all(|q| (q / ratios[0] - 1.0).abs() < 1e-9)
+    };
+    if !(0..keys.len()).any(proportional) {
+        axes.push(("δ_min (m)".into(), Box::new(|r: &Row| Some(r.delta_min))));
+    }
+    let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let mut fitted = Vec::new();
+    for (name, x) in &axes {
+        for (k, t) in times.iter().enumerate() {
+            let at: Vec<&Row> = rows.iter().filter(|r| r.time == *t).collect();
+            let xs: Option<Vec<f64>> = at.iter().map(|r| x(r)).collect();
+            let Some(xs) = xs else { continue };
+            let mut distinct = xs.clone();
+            distinct.sort_by(f64::total_cmp);
+            distinct.dedup();
+            if distinct.len() < 2 || distinct.len() != xs.len() {
+                continue;
+            }
+            let mut series = vec![Series::new(
+                "max abs diff (°C)",
+                xs.iter().zip(&at).map(|(x, r)| (*x, r.max_abs)).collect(),
+            )
+            .colour(0)];
+            if at.iter().all(|r| r.eq13.is_some_and(|e| e > 0.0)) {
+                series.push(
+                    Series::new(
+                        "eq 13",
+                        xs.iter()
+                            .zip(&at)
+                            .map(|(x, r)| (*x, r.eq13.unwrap_or(0.0)))
+                            .collect(),
+                    )
+                    .colour(1),
+                );
+            }
+            series.retain(|s| s.points.iter().all(|p| p.1 > 0.0));
+            if series.is_empty() {
+                continue;
+            }
+            let short = name.rsplit('.').next().unwrap_or(name);
+            let slug: String = if short.starts_with('δ') {
+                "delta".into()
+            } else {
+                short
+                    .chars()
+                    .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                    .collect()
+            };
+            let stem = out.join(format!("convergence_{slug}_t{}", k + 1));
+            let laws = convergence_plot(
+                &stem,
+                &Labels::new(
+                    format!("Convergence at t = {t} s"),
+                    name.clone(),
+                    "difference",
+                ),
+                &series,
+                Legend::LowerRight,
+            )?;
+            let stem = stem
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            for (s, law) in series.iter().zip(laws) {
+                fitted.push((stem.clone(), s.name.clone(), law.rate));
+            }
+        }
+    }
+    Ok(fitted)
+}
+
+/// One line plot per output time and probe line with every variant's PD temperatures
+/// (markers) and the reference (a line: the first variant's reference column, or the run
+/// compared with), into `out/lines_<line>_t<k>` (seed 004 Figs 5–25: PD for several
+/// configurations against FEM). Returns the stems written.
+pub fn line_plots(
+    variants: &[Variant],
+    rows: &[Row],
+    out: &Path,
+    against: &Against,
+) -> Result<Vec<String>> {
+    let Some(first) = variants.first() else {
+        return Ok(Vec::new());
+    };
+    let dim = first.case.spec.geometry.bare_cloud()?.dim;
+    let mut stems = Vec::new();
+    let times: Vec<f64> = {
+        let mut t: Vec<f64> = rows.iter().map(|r| r.time).collect();
+        t.sort_by(f64::total_cmp);
+        t.dedup();
+        t
+    };
+    let reference_dir = match against {
+        Against::Run(d) => Some(d.clone()),
+        _ => None,
+    };
+    let reference_summary = match &reference_dir {
+        Some(d) => Some(RunSummary::read(d)?),
+        None => None,
+    };
+    for (k, t) in times.iter().enumerate() {
+        let mut per_variant = Vec::new();
+        for v in variants {
+            let dir = out.join(&v.label);
+            let s = RunSummary::read(&dir)?;
+            if let Some(i) = s
+                .output_times
+                .iter()
+                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
+            {
+                per_variant.push((v, read_field(&dir.join(&s.fields[i]))?));
+            }
+        }
+        let Some((v0, f0)) = per_variant.first() else {
+            continue;
+        };
+        let reference = match (&reference_dir, &reference_summary) {
+            (Some(d), Some(s)) => s
+                .output_times
+                .iter()
+                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
+                .map(|i| read_field(&d.join(&s.fields[i])))
+                .transpose()?,
+            _ => None,
+        };
+        for line in probe_lines(&v0.case, f0, dim) {
+            let mut series = Vec::new();
+            let reference_points = match (&reference, &f0.reference) {
+                (Some(r), _) => Some(
+                    line.nodes(r)
+                        .iter()
+                        .map(|&(i, s)| (s, r.theta[i]))
+                        .collect::<Vec<_>>(),
+                ),
+                (None, Some(rv)) => Some(line.nodes(f0).iter().map(|&(i, s)| (s, rv[i])).collect()),
+                _ => None,
+            };
+            if let Some(p) = reference_points.filter(|p| !p.is_empty()) {
+                series.push(Series::new("reference", p).style(Style::Line).colour(7));
+            }
+            for (c, (v, f)) in per_variant.iter().enumerate() {
+                let p: Vec<(f64, f64)> = line
+                    .nodes(f)
+                    .iter()
+                    .map(|&(i, s)| (s, f.theta[i]))
+                    .collect();
+                if !p.is_empty() {
+                    series.push(
+                        Series::new(v.label.clone(), p)
+                            .style(Style::Markers)
+                            .colour(if c >= 7 { c + 1 } else { c }),
+                    );
+                }
+            }
+            if series.is_empty() {
+                continue;
+            }
+            let stem = out.join(format!("lines_{}_t{}", line.slug(), k + 1));
+            line_plot(
+                &stem,
+                &Labels::new(
+                    format!("Temperature along {} at t = {t} s", line.name),
+                    ["x (m)", "y (m)", "z (m)"][line.along],
+                    "Temperature (°C)",
+                ),
+                &series,
+                Legend::UpperLeft,
+            )?;
+            stems.push(
+                stem.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
+            );
+        }
+    }
+    Ok(stems)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CASE: &str = r#"
+dimension = 1
+[domain]
+min = [0.0]
+max = [1.0]
+[[region]]
+name = "bar"
+cells = [20]
+horizon = { factor = 3.0 }
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[time]
+end = 0.01
+"#;
+
+    /// `--vary` splits at top-level commas only and refuses empty values.
+    #[test]
+    fn parses_vary() {
+        let v: Vary = "region.0.cells=[10],[20]".parse().unwrap();
+        assert_eq!(v.key, "region.0.cells");
+        assert_eq!(v.values, vec!["[10]", "[20]"]);
+        assert!("region.0.cells".parse::<Vary>().is_err());
+        assert!("k=1,,2".parse::<Vary>().is_err());
+    }
+
+    /// The product of two keys gives four cases with the values set (an integer for a float
+    /// key becomes a float); a key that is not in the file is an error naming it.
+    #[test]
+    fn makes_the_product() {
+        let vary: Vec<Vary> = vec![
+            "region.*.horizon.factor=2,4".parse().unwrap(),
+            "region.0.cells=[10],[40]".parse().unwrap(),
+        ];
+        let v = variants(CASE, Path::new("bar.toml"), "", &vary).unwrap();
+        assert_eq!(v.len(), 4);
+        assert_eq!(v[1].label, "factor=2_cells=_40_");
+        let cloud = v[1].case.spec.geometry.bare_cloud().unwrap();
+        assert_eq!(cloud.n_body, 40);
+        assert!((cloud.horizon[0] / cloud.spacing[0] - 2.0).abs() < 1e-12);
+        let bad: Vec<Vary> = vec!["region.0.horizon.nope.x=1".parse().unwrap()];
+        let e = variants(CASE, Path::new("bar.toml"), "", &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bar.toml: region.0.horizon.nope.x: no such key"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,4 @@
+//! Helpers shared by the integration tests: independent classical reference solvers.
+#![allow(dead_code)]
+
+pub mod fd;
