@@ -118,6 +118,10 @@ enum Command {
         /// Output directory: one subdirectory per case, and an index over several.
         #[arg(long, short)]
         out: PathBuf,
+        /// Also solve each case with the built-in FEM (into <case>/fem/) and draw it along the
+        /// probe lines beside the case's own reference.
+        #[arg(long)]
+        fem: bool,
         /// No progress lines.
         #[arg(long, short)]
         quiet: bool,
@@ -274,7 +278,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             exclude_tips,
         } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
-        Command::Report { cases, out, quiet } => report(&cases, &out, quiet),
+        Command::Report {
+            cases,
+            out,
+            fem,
+            quiet,
+        } => report(&cases, &out, fem, quiet),
         Command::Sweep {
             cases,
             vary,
@@ -453,7 +462,7 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
 
 /// `peritherm report`: runs each case (directories: every case file in them) and writes its
 /// report into --out/<case>/; with several cases, one index over all of them.
-fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Result<()> {
+fn report(inputs: &[PathBuf], out: &std::path::Path, fem: bool, quiet: bool) -> anyhow::Result<()> {
     use peritherm::case::ReferenceSource;
     use peritherm::report::page::{write_index, write_report};
     let mut cases = Vec::new();
@@ -489,7 +498,17 @@ fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Res
             Some(ReferenceSource::Fem(_)) => "FEM",
             None => "none",
         };
-        let w = write_report(&case, &run, &dir, reference)?;
+        let fem_dir = dir.join("fem");
+        let extra = if fem && reference != "FEM" {
+            if !quiet {
+                eprintln!("{}: FEM into {}", path.display(), fem_dir.display());
+            }
+            peritherm::fem::run_fem(&case, &fem_dir, &Default::default(), |_, _| {})?;
+            Some((fem_dir.as_path(), "FEM"))
+        } else {
+            None
+        };
+        let w = write_report(&case, &run, &dir, reference, extra)?;
         say!("{}: {}", path.display(), dir.join("index.html").display());
         written.push(w);
     }

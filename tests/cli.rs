@@ -344,9 +344,10 @@ fn sweep_writes_a_table_and_converges_in_delta() {
     );
 }
 
-/// `peritherm report` on two small cases (one cracked, with a series reference and a probe
-/// line) writes each report's line, error, map and damage plots, report.md with the metrics
-/// table, index.html, and one index over both; a case that does not exist is one line.
+/// `peritherm report --fem` on two small cases (one cracked, with a series reference and a
+/// probe line) writes each report's line plots (PD, series and FEM), error, map and damage
+/// plots, report.md with the metrics table, index.html, and one index over both; a case that
+/// does not exist is one line.
 #[test]
 fn report_writes_plots_pages_and_an_index() {
     let dir = tempfile::tempdir().unwrap();
@@ -404,7 +405,15 @@ initial = 40.0
         &square("[[crack]]\npoints = [[0.3, 0.5], [0.7, 0.5]]"),
     );
     let out = dir.path().join("reports");
-    let o = peritherm(&["report", &a, &b, "--out", out.to_str().unwrap(), "--quiet"]);
+    let o = peritherm(&[
+        "report",
+        &a,
+        &b,
+        "--out",
+        out.to_str().unwrap(),
+        "--fem",
+        "--quiet",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for f in ["line_y_0.46875", "error_y_0.46875", "map_1", "map_2"] {
         for ext in ["png", "svg"] {
@@ -417,6 +426,9 @@ initial = 40.0
         }
     }
     assert!(out.join("cracked/damage_2.png").exists());
+    assert!(out.join("cracked/fem/field_2.csv").exists());
+    let svg = std::fs::read_to_string(out.join("plain/line_y_0.46875.svg")).unwrap();
+    assert!(svg.contains("FEM, t = 0.02 s") && svg.contains("series, t = 0.02 s"));
     assert!(!out.join("plain/damage_2.png").exists());
     let md = std::fs::read_to_string(out.join("plain/report.md")).unwrap();
     assert!(md.contains("| t (s) | max abs diff (°C) |") && md.contains("![map_1](map_1.png)"));

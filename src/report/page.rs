@@ -165,8 +165,16 @@ pub struct Written {
 }
 
 /// Writes the report of the finished run in `run` of `case` into `dir`: the line plots, the
-/// maps (2D), `report.md` and `index.html`. `reference_name` names the reference in legends.
-pub fn write_report(case: &Case, run: &Path, dir: &Path, reference_name: &str) -> Result<Written> {
+/// maps (2D), `report.md` and `index.html`. `reference_name` names the reference in legends;
+/// `extra` is another finished run of the same case (e.g. `peritherm fem`) drawn along the
+/// probe lines as dashed lines, with its name.
+pub fn write_report(
+    case: &Case,
+    run: &Path,
+    dir: &Path,
+    reference_name: &str,
+    extra: Option<(&Path, &str)>,
+) -> Result<Written> {
     std::fs::create_dir_all(dir).map_err(|error| crate::error::Error::Io {
         path: dir.to_path_buf(),
         error,
@@ -178,6 +186,24 @@ pub fn write_report(case: &Case, run: &Path, dir: &Path, reference_name: &str) -
         .map(|f| read_field(&run.join(f)))
         .collect::<Result<Vec<_>>>()?;
     let dim = case.spec.geometry.bare_cloud()?.dim;
+    let extra_fields = match extra {
+        Some((d, name)) => {
+            let s = RunSummary::read(d)?;
+            let mut by_output = Vec::new();
+            for t in &summary.output_times {
+                let k = s
+                    .output_times
+                    .iter()
+                    .position(|x| (x - t).abs() <= 1e-9 * t.abs());
+                by_output.push(match k {
+                    Some(k) => Some(read_field(&d.join(&s.fields[k]))?),
+                    None => None,
+                });
+            }
+            Some((by_output, name))
+        }
+        None => None,
+    };
     let mut plots = Vec::new();
     let stem_name = |p: &Path| {
         p.strip_prefix(dir)
@@ -201,6 +227,22 @@ pub fn write_report(case: &Case, run: &Path, dir: &Path, reference_name: &str) -
                         .style(Style::Markers)
                         .colour(k),
                 );
+                if let Some((by_output, name)) = &extra_fields {
+                    if let Some(Some(e)) = by_output.get(k) {
+                        let p: Vec<(f64, f64)> = line
+                            .nodes(e)
+                            .iter()
+                            .map(|&(i, s)| (s, e.theta[i]))
+                            .collect();
+                        if !p.is_empty() {
+                            temps.push(
+                                Series::new(format!("{name}, t = {t} s"), p)
+                                    .style(Style::Dashed)
+                                    .colour(k),
+                            );
+                        }
+                    }
+                }
                 if let Some(r) = &f.reference {
                     let rf: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, r[i])).collect();
                     temps.push(
