@@ -606,7 +606,23 @@ pub fn line_plots(
             if let Some(p) = reference_points.filter(|p| !p.is_empty()) {
                 series.push(Series::new("reference", p).style(Style::Line).colour(7));
             }
+            let mut diffs = Vec::new();
             for (c, (v, f)) in per_variant.iter().enumerate() {
+                let colour = if c >= 7 { c + 1 } else { c };
+                if let Some(r) = &f.reference {
+                    let d: Vec<(f64, f64)> = line
+                        .nodes(f)
+                        .iter()
+                        .map(|&(i, s)| (s, f.theta[i] - r[i]))
+                        .collect();
+                    if !d.is_empty() {
+                        diffs.push(
+                            Series::new(v.label.clone(), d)
+                                .style(Style::LineMarkers)
+                                .colour(colour),
+                        );
+                    }
+                }
                 let p: Vec<(f64, f64)> = line
                     .nodes(f)
                     .iter()
@@ -616,12 +632,31 @@ pub fn line_plots(
                     series.push(
                         Series::new(v.label.clone(), p)
                             .style(Style::Markers)
-                            .colour(if c >= 7 { c + 1 } else { c }),
+                            .colour(colour),
                     );
                 }
             }
             if series.is_empty() {
                 continue;
+            }
+            if !diffs.is_empty() {
+                let stem = out.join(format!("differences_{}_t{}", line.slug(), k + 1));
+                line_plot(
+                    &stem,
+                    &Labels::new(
+                        format!("PD − reference along {} at t = {t} s", line.name),
+                        ["x (m)", "y (m)", "z (m)"][line.along],
+                        "Difference (°C)",
+                    ),
+                    &diffs,
+                    Legend::UpperLeft,
+                )?;
+                stems.push(
+                    stem.file_name()
+                        .unwrap_or_default()
+                        .to_string_lossy()
+                        .into_owned(),
+                );
             }
             let stem = out.join(format!("lines_{}_t{}", line.slug(), k + 1));
             line_plot(
