@@ -327,6 +327,9 @@ pub struct ReferenceSection {
     /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`, m.
     #[serde(default)]
     pub line_y: Option<f64>,
+    /// A vertical probe line x = `line_x` for the report's plots (seed 004 §4.3), m.
+    #[serde(default)]
+    pub line_x: Option<f64>,
     /// A point whose nearest body node is reported at every output (e.g. seed 000's midpoint), m.
     #[serde(default)]
     pub probe: Option<Vec<f64>>,
@@ -348,6 +351,8 @@ pub struct ReferenceSpec {
     pub source: ReferenceSource,
     /// Probe line for seed 003 eq 13 (y = line_y), m.
     pub line_y: Option<f64>,
+    /// Vertical probe line x = line_x of the report, m.
+    pub line_x: Option<f64>,
     /// The point whose nearest body node is reported, m.
     pub probe: Option<Point>,
 }
@@ -424,12 +429,15 @@ fn reference(
         }
         None => None,
     };
-    if let Some(y) = r.line_y {
-        if !y.is_finite() || dim < 2 {
+    for (key, v) in [
+        ("reference.line_y", r.line_y),
+        ("reference.line_x", r.line_x),
+    ] {
+        if v.is_some_and(|v| !v.is_finite() || dim < 2) {
             return Err(case_err(
                 path,
-                "reference.line_y",
-                "must be a finite y coordinate of a 2D or 3D case",
+                key,
+                "must be a finite coordinate of a 2D or 3D case",
             ));
         }
     }
@@ -454,6 +462,7 @@ fn reference(
     Ok(ReferenceSpec {
         source,
         line_y: r.line_y,
+        line_x: r.line_x,
         probe,
     })
 }

@@ -63,6 +63,15 @@ pub enum Error {
         /// What is wrong and how to fix it.
         message: String,
     },
+    /// A plot whose data cannot be drawn (empty, non-finite, zero-size range) or whose
+    /// files cannot be written.
+    #[error("{path}: {message}")]
+    Plot {
+        /// The plot's file stem (`<stem>.png`, `<stem>.svg`).
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// Output could not be written.
     #[error("{path}: {error}")]
     Io {

@@ -16,6 +16,7 @@ pub mod consistency;
 pub mod crack;
 pub mod error;
 pub mod expr;
+pub mod fem;
 pub mod gmsh;
 pub mod kernel;
 pub mod material;

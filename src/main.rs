@@ -4,6 +4,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use peritherm::case::Case;
+use peritherm::fem::{run_fem, FemOptions, Scheme};
 use peritherm::model::{crack_cutters, Model};
 use peritherm::output::read_field;
 use peritherm::output::RunSummary;
@@ -41,6 +42,28 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Solve a case with the built-in classical FEM reference and write the same outputs as
+    /// `run` (field_<k>.csv, field_<k>.vtu, run.json) into --out.
+    Fem {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Element size of the structured mesh of a box case, m (default: the finest region
+        /// spacing); a gmsh case uses its own mesh.
+        #[arg(long)]
+        h: Option<f64>,
+        /// Time scheme (Crank–Nicolson starts with four backward-Euler half steps).
+        #[arg(long, value_enum, default_value = "crank-nicolson")]
+        scheme: FemScheme,
+        /// Time step, s (default: min(end/1000, first output/100)).
+        #[arg(long)]
+        dt: Option<f64>,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Print a Markdown table comparing finished runs with their references.
     Table {
         /// Output directories of `peritherm run`.
@@ -58,8 +81,8 @@ enum Command {
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
     },
-    /// Draw a temperature map (PNG) of every output of a 2D run, cracks included, into the
-    /// run's directory as map_<k>.png.
+    /// Draw temperature maps (PNG and SVG) of every output of a 2D run, cracks included, into
+    /// the run's directory as map_<k>.png/.svg, and damage_<k>.png/.svg for runs with cracks.
     Plot {
         /// Output directory of `peritherm run`.
         run: PathBuf,
@@ -86,11 +109,35 @@ enum Command {
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
     },
+    /// Run cases and write reports: plots of PD against the reference along the probe lines,
+    /// the error along them, temperature/damage/flux maps, report.md and index.html.
+    Report {
+        /// Case files, or directories of case files.
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// Output directory: one subdirectory per case, and an index over several.
+        #[arg(long, short)]
+        out: PathBuf,
+        /// No progress lines.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Validate a case and print its size and stable time step without running it.
     Check {
         /// The case file (TOML).
         case: PathBuf,
     },
+}
+
+/// Time schemes of `peritherm fem`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FemScheme {
+    /// Backward Euler (first order, no oscillations).
+    BackwardEuler,
+    /// Crank–Nicolson (second order).
+    CrankNicolson,
+    /// The steady state at every output time.
+    Steady,
 }
 
 /// Prints a line to stdout; a closed pipe (e.g. `| head`) ends the output quietly.
@@ -159,6 +206,59 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Fem {
+            case,
+            out,
+            h,
+            scheme,
+            dt,
+            quiet,
+        } => {
+            let case = Case::load(&case)?;
+            let scheme = match scheme {
+                FemScheme::BackwardEuler => Scheme::BackwardEuler,
+                FemScheme::CrankNicolson => Scheme::CrankNicolson,
+                FemScheme::Steady => Scheme::Steady,
+            };
+            let bar = ProgressBar::new(0);
+            if quiet || !std::io::stderr().is_terminal() {
+                bar.set_draw_target(ProgressDrawTarget::hidden());
+            }
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}",
+                )
+                .expect("valid template"),
+            );
+            let opts = FemOptions { h, scheme, dt };
+            let summary = run_fem(&case, &out, &opts, |done, total| {
+                bar.set_length(total);
+                bar.set_position(done);
+            })?;
+            bar.finish_and_clear();
+            say!(
+                "{}: FEM, {} nodes, {} matrix entries, {} {} steps of {:.3e} s in {:.2} s (set-up {:.2} s) -> {}",
+                case.path.display(),
+                summary.nodes,
+                summary.pairs,
+                summary.steps,
+                summary.integrator,
+                summary.dt,
+                summary.wall_seconds,
+                summary.setup_seconds,
+                out.display()
+            );
+            for c in &summary.reference {
+                say!(
+                    "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
+                    c.time,
+                    c.max_abs_diff,
+                    c.mean_sq_rel_diff,
+                    c.l2_rel_line
+                );
+            }
+            Ok(())
+        }
         Command::Table { runs } => {
             say!("{}", RunSummary::table_header());
             for dir in runs {
@@ -174,6 +274,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             exclude_tips,
         } => compare(&run, &reference, exclude_tips),
         Command::Plot { run } => plot(&run),
+        Command::Report { cases, out, quiet } => report(&cases, &out, quiet),
         Command::Sweep {
             cases,
             vary,
@@ -321,15 +422,34 @@ fn sweep(
     let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
         eprintln!("[{}/{n}] {label}", k + 1);
     })?;
-    let table = sweep::markdown(&rows);
+    let mut table = sweep::markdown(&rows);
+    let rates = sweep::convergence_plots(&rows, out)?;
+    let lines = sweep::line_plots(&variants, &rows, out, &against)?;
+    if !rates.is_empty() {
+        table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
+        for (stem, series, rate) in &rates {
+            table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
+        }
+    }
+    let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
+    plots.dedup();
+    plots.extend(lines.iter());
+    if !plots.is_empty() {
+        table.push('\n');
+        for p in plots {
+            table.push_str(&format!("![{p}]({p}.png)\n\n"));
+        }
+    }
     peritherm::output::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
     peritherm::output::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
     say!("{table}");
-    say!("-> {}", out.join("sweep.csv").display());
+    say!("-> {}", out.join("sweep.md").display());
     Ok(())
 }
 
-/// `peritherm plot`: one temperature map per output, on a colour range shared by all of them.
+/// `peritherm plot`: per output a temperature map (one colour range for all outputs, cracks as
+/// they are at that time, region boundaries, flux arrows when the run has cracks) and, for runs
+/// with damage, a damage map; PNG and SVG.
 fn plot(run: &std::path::Path) -> anyhow::Result<()> {
     let summary = RunSummary::read(run)?;
     let case = Case::load(std::path::Path::new(&summary.case))?;
@@ -339,25 +459,61 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
             run.display()
         );
     }
-    let cloud = case.spec.geometry.bare_cloud()?;
-    let cutters = crack_cutters(&cloud, &case.spec.cracks);
     let fields = summary
         .fields
         .iter()
         .map(|f| read_field(&run.join(f)))
         .collect::<Result<Vec<_>, _>>()?;
-    let (lo, hi) = fields
-        .iter()
-        .flat_map(|f| f.theta.iter())
-        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
-    for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
-        let path = run.join(format!("map_{}.png", k + 1));
-        let cracks = peritherm::crack::segments_at(&cutters, *t);
-        peritherm::plot::temperature_map(&path, &f.pos, &f.theta, &f.spacing, (lo, hi), &cracks)?;
-        say!(
-            "t = {t} s: {} (blue {lo:.2} °C … white … red {hi:.2} °C)",
-            path.display()
-        );
+    for stem in peritherm::report::page::draw_maps(&case, &summary, &fields, run)? {
+        say!("{}.png/.svg", stem.display());
+    }
+    Ok(())
+}
+
+/// `peritherm report`: runs each case (directories: every case file in them) and writes its
+/// report into --out/<case>/; with several cases, one index over all of them.
+fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Result<()> {
+    use peritherm::case::ReferenceSource;
+    use peritherm::report::page::{write_index, write_report};
+    let mut cases = Vec::new();
+    for p in inputs {
+        if p.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(p)
+                .with_context(|| format!("{}: cannot list", p.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .collect();
+            found.sort();
+            cases.extend(found);
+        } else {
+            cases.push(p.clone());
+        }
+    }
+    let mut written = Vec::new();
+    for path in &cases {
+        let case = Case::load(path)?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "case".into());
+        let dir = out.join(&stem);
+        let run = dir.join("run");
+        if !quiet {
+            eprintln!("{}: running into {}", path.display(), run.display());
+        }
+        run_case(&case, &run, |_, _| {})?;
+        let reference = match case.reference.as_ref().map(|r| &r.source) {
+            Some(ReferenceSource::Analytic(_)) => "series",
+            Some(ReferenceSource::Table(_)) => "reference table",
+            None => "none",
+        };
+        let w = write_report(&case, &run, &dir, reference)?;
+        say!("{}: {}", path.display(), dir.join("index.html").display());
+        written.push(w);
+    }
+    if written.len() > 1 {
+        write_index(out, &written)?;
+        say!("index: {}", out.join("index.html").display());
     }
     Ok(())
 }

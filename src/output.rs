@@ -44,16 +44,23 @@ pub struct Fields<'a> {
     pub damage: &'a [f64],
     /// Peridynamic heat flux per body node (formulation §8), W/m².
     pub flux: &'a [Vector],
+    /// The case's classical reference at each body node, °C, if it has one.
+    pub reference: Option<&'a [f64]>,
 }
 
 /// CSV text of the body nodes: position, temperature, region, spacing, horizon, volume,
-/// damage and heat flux.
+/// damage and heat flux, and the classical reference when the case has one.
 pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
-    let mut s = String::with_capacity(cloud.n_body * 120);
-    s.push_str("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz\n");
+    let mut s = String::with_capacity(cloud.n_body * 140);
+    s.push_str("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz");
+    s.push_str(if f.reference.is_some() {
+        ",reference\n"
+    } else {
+        "\n"
+    });
     for i in 0..cloud.n_body {
         let (p, q) = (cloud.pos[i], f.flux[i]);
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{}",
             p.x,
@@ -69,6 +76,12 @@ pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
             q.y,
             q.z
         );
+        match f.reference {
+            Some(r) => {
+                let _ = writeln!(s, ",{}", r[i]);
+            }
+            None => s.push('\n'),
+        }
     }
     s
 }
@@ -108,7 +121,8 @@ fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
 }
 
 /// A VTK unstructured grid (`.vtu`) of the body nodes as vertices, with temperature, heat
-/// flux, damage, horizon, spacing, volume and region, for ParaView.
+/// flux, damage, the classical reference (if any), horizon, spacing, volume and region, for
+/// ParaView.
 pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
     let n = cloud.n_body;
     let mut s = String::with_capacity(n * 140);
@@ -131,6 +145,15 @@ pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
         1,
         &f64_bytes(f.damage.iter().copied()),
     );
+    if let Some(r) = f.reference {
+        vtk_array(
+            &mut s,
+            "Float64",
+            "reference",
+            1,
+            &f64_bytes(r.iter().copied()),
+        );
+    }
     for (name, v) in [
         ("horizon", &cloud.horizon),
         ("spacing", &cloud.spacing),
@@ -170,9 +193,18 @@ pub struct FieldRows {
     pub theta: Vec<f64>,
     /// Spacings Δ, m.
     pub spacing: Vec<f64>,
+    /// Region index of each node (0 if the file has no such column).
+    pub region: Vec<u32>,
+    /// Damage φ of each node (0 if the file has no such column).
+    pub damage: Vec<f64>,
+    /// Peridynamic heat flux of each node, W/m² (0 if the file has no such columns).
+    pub flux: Vec<Vector>,
+    /// The classical reference at each node, °C, when the file has a `reference` column.
+    pub reference: Option<Vec<f64>>,
 }
 
-/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first).
+/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first; damage and
+/// qx, qy, qz when present).
 pub fn read_field(path: &Path) -> Result<FieldRows> {
     let bad = |m: String| Error::Io {
         path: path.to_path_buf(),
@@ -183,10 +215,8 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         error,
     })?;
     let mut lines = text.lines();
-    if !lines
-        .next()
-        .is_some_and(|h| h.starts_with("x,y,z,temperature,region,spacing"))
-    {
+    let header = lines.next().unwrap_or("");
+    if !header.starts_with("x,y,z,temperature,region,spacing") {
         return Err(bad(
             "not a peritherm field file (header x,y,z,temperature,region,spacing,...)".into(),
         ));
@@ -195,11 +225,17 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         pos: Vec::new(),
         theta: Vec::new(),
         spacing: Vec::new(),
+        region: Vec::new(),
+        damage: Vec::new(),
+        flux: Vec::new(),
+        reference: None,
     };
+    let reference_column = header.split(',').position(|c| c == "reference");
+    let mut reference = Vec::new();
     for (k, line) in lines.enumerate() {
         let v: Vec<f64> = line
             .split(',')
-            .take(6)
+            .take(reference_column.map_or(12, |c| c + 1).max(12))
             .map(str::parse)
             .collect::<std::result::Result<_, _>>()
             .map_err(|e| bad(format!("line {}: {e}", k + 2)))?;
@@ -209,7 +245,18 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         rows.pos.push(Point::new(v[0], v[1], v[2]));
         rows.theta.push(v[3]);
         rows.spacing.push(v[5]);
+        rows.region.push(v[4] as u32);
+        let extra = |k: usize| v.get(k).copied().unwrap_or(0.0);
+        rows.damage.push(extra(8));
+        rows.flux.push(Vector::new(extra(9), extra(10), extra(11)));
+        if let Some(c) = reference_column {
+            let r = v
+                .get(c)
+                .ok_or_else(|| bad(format!("line {}: no reference value", k + 2)))?;
+            reference.push(*r);
+        }
     }
+    rows.reference = reference_column.map(|_| reference);
     Ok(rows)
 }
 
@@ -253,6 +300,9 @@ pub struct RunSummary {
     pub title: String,
     /// Case file.
     pub case: String,
+    /// Solver that wrote the run: `peridynamics` or `fem` (run.json files without it: peridynamics).
+    #[serde(default = "peridynamics")]
+    pub solver: String,
     /// Body nodes.
     pub nodes: usize,
     /// Fictitious nodes.
@@ -265,7 +315,7 @@ pub struct RunSummary {
     pub steps: u64,
     /// Time step, s.
     pub dt: f64,
-    /// Stable bound on the step, s.
+    /// Stable bound on the step, s (0 for the FEM solver, whose schemes are unconditionally stable).
     pub dt_stable: f64,
     /// Integrator.
     pub integrator: String,
@@ -293,6 +343,10 @@ pub struct RunSummary {
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,
+}
+
+fn peridynamics() -> String {
+    "peridynamics".into()
 }
 
 impl RunSummary {

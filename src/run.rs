@@ -70,10 +70,21 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         let path = field_path(out, k + 1);
         let flux = conductance.flux(&model.cloud, th);
         let damage = model.damage_at(t);
+        let classical = match &case.reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                comparisons.push(compare(&model.cloud, th, &classical, r, t));
+                reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
+        };
         let f = Fields {
             theta: th,
             damage: &damage,
             flux: &flux,
+            reference: classical.as_deref(),
         };
         write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
         write_atomic(
@@ -86,12 +97,6 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
                 .to_string_lossy()
                 .into_owned(),
         );
-        if let Some(r) = &case.reference {
-            let started = Instant::now();
-            let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-            comparisons.push(compare(&model.cloud, th, &classical, r, t));
-            reference_seconds += started.elapsed().as_secs_f64();
-        }
         Ok(())
     };
     let result = match implicit.as_mut() {
@@ -127,6 +132,7 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let summary = RunSummary {
         title: case.title.clone(),
         case: case.path.display().to_string(),
+        solver: "peridynamics".into(),
         nodes: model.cloud.n_body,
         fictitious_nodes: model.cloud.n_fictitious(),
         bonds: model.horizons.n_bonds(),

@@ -8,7 +8,9 @@ use crate::crack::tips_at;
 use crate::error::{Error, Result};
 use crate::model::crack_cutters;
 use crate::output::{read_field, RunSummary};
+use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
 use crate::report::field_difference;
+use crate::report::page::probe_lines;
 use crate::run::run_case;
 use std::path::{Path, PathBuf};
 
@@ -433,6 +435,211 @@ pub fn run(
         }
     }
     Ok(rows)
+}
+
+/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
+/// eq 13 where there is one) against each varied key whose values are positive numbers, and
+/// against the smallest horizon δ when it varies, on log–log axes with fitted rates (seed 000
+/// Figs 10–12, seed 003 Figs 11–12). Returns the stems written and the fitted rates as
+/// (stem, series, rate).
+pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+    let mut axes: Vec<(String, Box<dyn Fn(&Row) -> Option<f64>>)> = Vec::new();
+    let keys: Vec<String> = rows
+        .first()
+        .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    for (i, k) in keys.iter().enumerate() {
+        axes.push((
+            k.clone(),
+            Box::new(move |r: &Row| r.settings[i].1.parse::<f64>().ok().filter(|v| *v > 0.0)),
+        ));
+    }
+    // δ_min unless it is proportional to a varied key (the same plot again)
+    let proportional = |i: usize| {
+        let ratios: Vec<f64> = rows
+            .iter()
+            .filter_map(|r| Some(r.settings[i].1.parse::<f64>().ok()? / r.delta_min))
+            .collect();
+        ratios.len() == rows.len() && ratios.iter().all(|q| (q / ratios[0] - 1.0).abs() < 1e-9)
+    };
+    if !(0..keys.len()).any(proportional) {
+        axes.push(("δ_min (m)".into(), Box::new(|r: &Row| Some(r.delta_min))));
+    }
+    let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let mut fitted = Vec::new();
+    for (name, x) in &axes {
+        for (k, t) in times.iter().enumerate() {
+            let at: Vec<&Row> = rows.iter().filter(|r| r.time == *t).collect();
+            let xs: Option<Vec<f64>> = at.iter().map(|r| x(r)).collect();
+            let Some(xs) = xs else { continue };
+            let mut distinct = xs.clone();
+            distinct.sort_by(f64::total_cmp);
+            distinct.dedup();
+            if distinct.len() < 2 || distinct.len() != xs.len() {
+                continue;
+            }
+            let mut series = vec![Series::new(
+                "max abs diff (°C)",
+                xs.iter().zip(&at).map(|(x, r)| (*x, r.max_abs)).collect(),
+            )
+            .colour(0)];
+            if at.iter().all(|r| r.eq13.is_some_and(|e| e > 0.0)) {
+                series.push(
+                    Series::new(
+                        "eq 13",
+                        xs.iter()
+                            .zip(&at)
+                            .map(|(x, r)| (*x, r.eq13.unwrap_or(0.0)))
+                            .collect(),
+                    )
+                    .colour(1),
+                );
+            }
+            series.retain(|s| s.points.iter().all(|p| p.1 > 0.0));
+            if series.is_empty() {
+                continue;
+            }
+            let short = name.rsplit('.').next().unwrap_or(name);
+            let slug: String = if short.starts_with('δ') {
+                "delta".into()
+            } else {
+                short
+                    .chars()
+                    .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                    .collect()
+            };
+            let stem = out.join(format!("convergence_{slug}_t{}", k + 1));
+            let laws = convergence_plot(
+                &stem,
+                &Labels::new(
+                    format!("Convergence at t = {t} s"),
+                    name.clone(),
+                    "difference",
+                ),
+                &series,
+                Legend::LowerRight,
+            )?;
+            let stem = stem
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            for (s, law) in series.iter().zip(laws) {
+                fitted.push((stem.clone(), s.name.clone(), law.rate));
+            }
+        }
+    }
+    Ok(fitted)
+}
+
+/// One line plot per output time and probe line with every variant's PD temperatures
+/// (markers) and the reference (a line: the first variant's reference column, or the run
+/// compared with), into `out/lines_<line>_t<k>` (seed 004 Figs 5–25: PD for several
+/// configurations against FEM). Returns the stems written.
+pub fn line_plots(
+    variants: &[Variant],
+    rows: &[Row],
+    out: &Path,
+    against: &Against,
+) -> Result<Vec<String>> {
+    let Some(first) = variants.first() else {
+        return Ok(Vec::new());
+    };
+    let dim = first.case.spec.geometry.bare_cloud()?.dim;
+    let mut stems = Vec::new();
+    let times: Vec<f64> = {
+        let mut t: Vec<f64> = rows.iter().map(|r| r.time).collect();
+        t.sort_by(f64::total_cmp);
+        t.dedup();
+        t
+    };
+    let reference_dir = match against {
+        Against::Run(d) => Some(d.clone()),
+        _ => None,
+    };
+    let reference_summary = match &reference_dir {
+        Some(d) => Some(RunSummary::read(d)?),
+        None => None,
+    };
+    for (k, t) in times.iter().enumerate() {
+        let mut per_variant = Vec::new();
+        for v in variants {
+            let dir = out.join(&v.label);
+            let s = RunSummary::read(&dir)?;
+            if let Some(i) = s
+                .output_times
+                .iter()
+                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
+            {
+                per_variant.push((v, read_field(&dir.join(&s.fields[i]))?));
+            }
+        }
+        let Some((v0, f0)) = per_variant.first() else {
+            continue;
+        };
+        let reference = match (&reference_dir, &reference_summary) {
+            (Some(d), Some(s)) => s
+                .output_times
+                .iter()
+                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
+                .map(|i| read_field(&d.join(&s.fields[i])))
+                .transpose()?,
+            _ => None,
+        };
+        for line in probe_lines(&v0.case, f0, dim) {
+            let mut series = Vec::new();
+            let reference_points = match (&reference, &f0.reference) {
+                (Some(r), _) => Some(
+                    line.nodes(r)
+                        .iter()
+                        .map(|&(i, s)| (s, r.theta[i]))
+                        .collect::<Vec<_>>(),
+                ),
+                (None, Some(rv)) => Some(line.nodes(f0).iter().map(|&(i, s)| (s, rv[i])).collect()),
+                _ => None,
+            };
+            if let Some(p) = reference_points.filter(|p| !p.is_empty()) {
+                series.push(Series::new("reference", p).style(Style::Line).colour(7));
+            }
+            for (c, (v, f)) in per_variant.iter().enumerate() {
+                let p: Vec<(f64, f64)> = line
+                    .nodes(f)
+                    .iter()
+                    .map(|&(i, s)| (s, f.theta[i]))
+                    .collect();
+                if !p.is_empty() {
+                    series.push(
+                        Series::new(v.label.clone(), p)
+                            .style(Style::Markers)
+                            .colour(if c >= 7 { c + 1 } else { c }),
+                    );
+                }
+            }
+            if series.is_empty() {
+                continue;
+            }
+            let stem = out.join(format!("lines_{}_t{}", line.slug(), k + 1));
+            line_plot(
+                &stem,
+                &Labels::new(
+                    format!("Temperature along {} at t = {t} s", line.name),
+                    ["x (m)", "y (m)", "z (m)"][line.along],
+                    "Temperature (°C)",
+                ),
+                &series,
+                Legend::UpperLeft,
+            )?;
+            stems.push(
+                stem.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
+            );
+        }
+    }
+    Ok(stems)
 }
 
 #[cfg(test)]

@@ -343,3 +343,88 @@ fn sweep_writes_a_table_and_converges_in_delta() {
         "{e}"
     );
 }
+
+/// `peritherm report` on two small cases (one cracked, with a series reference and a probe
+/// line) writes each report's line, error, map and damage plots, report.md with the metrics
+/// table, index.html, and one index over both; a case that does not exist is one line.
+#[test]
+fn report_writes_plots_pages_and_an_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = |crack: &str| {
+        format!(
+            r#"
+title = "small square"
+dimension = 2
+[domain]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[[region]]
+name = "square"
+cells = [16, 16]
+horizon = {{ factor = 3 }}
+[material.m]
+conductivity = 1.14
+density = 1.0
+specific_heat = 1.0
+[boundary.x_min]
+type = "temperature"
+value = 0.0
+[boundary.x_max]
+type = "temperature"
+value = 0.0
+[boundary.y_min]
+type = "temperature"
+value = 0.0
+[boundary.y_max]
+type = "temperature"
+value = 0.0
+{crack}
+[initial]
+value = 40.0
+[time]
+end = 0.02
+outputs = [0.01, 0.02]
+[reference]
+line_y = 0.46875
+[reference.solution]
+kind = "square_fixed_edges"
+x0 = 0.0
+y0 = 0.0
+length = 1.0
+diffusivity = 1.14
+edge = 0.0
+initial = 40.0
+"#
+        )
+    };
+    let a = write_case(dir.path(), "plain.toml", &square(""));
+    let b = write_case(
+        dir.path(),
+        "cracked.toml",
+        &square("[[crack]]\npoints = [[0.3, 0.5], [0.7, 0.5]]"),
+    );
+    let out = dir.path().join("reports");
+    let o = peritherm(&["report", &a, &b, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["line_y_0.46875", "error_y_0.46875", "map_1", "map_2"] {
+        for ext in ["png", "svg"] {
+            let p = out.join(format!("plain/{f}.{ext}"));
+            assert!(
+                std::fs::metadata(&p).unwrap().len() > 1000,
+                "{}",
+                p.display()
+            );
+        }
+    }
+    assert!(out.join("cracked/damage_2.png").exists());
+    assert!(!out.join("plain/damage_2.png").exists());
+    let md = std::fs::read_to_string(out.join("plain/report.md")).unwrap();
+    assert!(md.contains("| t (s) | max abs diff (°C) |") && md.contains("![map_1](map_1.png)"));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("plain/index.html") && html.contains("cracked/index.html"));
+    let field = std::fs::read_to_string(out.join("plain/run/field_1.csv")).unwrap();
+    assert!(field.lines().next().unwrap().ends_with(",qz,reference"));
+    let o = peritherm(&["report", "nope.toml", "--out", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
+}

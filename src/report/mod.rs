@@ -1,4 +1,7 @@
-//! Measures that compare a run with a classical solution (formulation §9).
+//! Measures that compare a run with a classical solution (formulation §9), and the report
+//! pages that show them ([`page`]).
+
+pub mod page;
 
 use crate::case::{ReferenceSource, ReferenceSpec};
 use crate::cloud::Cloud;

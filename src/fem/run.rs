@@ -1,0 +1,287 @@
+//! Running a case with the FEM solver: the same outputs as `peritherm run` (field_<k>.csv,
+//! field_<k>.vtu, run.json with the reference comparison), written atomically.
+
+use super::assemble::{assemble, System};
+use super::boundary::Conditions;
+use super::field::{output_cloud, Recovery};
+use super::grid::box_mesh;
+use super::mesh::FemMesh;
+use super::solve::{Scheme, Stepper};
+use super::split::{check_cracks, crack_facets, split};
+use crate::case::Case;
+use crate::cloud::Cloud;
+use crate::error::{Error, Result};
+use crate::math::Vector;
+use crate::model::{crack_cutters, Geometry, Initial};
+use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
+use crate::report::{classical_at, compare};
+use std::path::Path;
+use std::time::Instant;
+
+/// Settings of a FEM run that the case file does not hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FemOptions {
+    /// Element size of the structured mesh of a box case, m (default: the finest region spacing).
+    pub h: Option<f64>,
+    /// Time scheme (default Crank–Nicolson).
+    pub scheme: Scheme,
+    /// Time step, s (default [`default_dt`]); steps shrink to land on every output time.
+    pub dt: Option<f64>,
+}
+
+impl Default for FemOptions {
+    fn default() -> Self {
+        FemOptions {
+            h: None,
+            scheme: Scheme::CrankNicolson,
+            dt: None,
+        }
+    }
+}
+
+/// Default step: min(end/1000, first output/100), s. The case's `time.dt` is the explicit PD
+/// step (tiny, stability-bound) and is not used.
+pub fn default_dt(case: &Case) -> f64 {
+    let first = case.outputs.first().copied().unwrap_or(case.end);
+    (case.end / 1000.0).min(first / 100.0)
+}
+
+/// The FEM mesh of a case (split along its cracks) and the number of nodes the split added.
+pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
+    let spec = &case.spec;
+    check_cracks(&spec.cracks)?;
+    let mut mesh = match &spec.geometry {
+        Geometry::Box(g) => {
+            let finest = g
+                .regions
+                .iter()
+                .map(|r| r.spacing())
+                .fold(f64::INFINITY, f64::min);
+            box_mesh(g, h.unwrap_or(finest), &spec.cracks)?
+        }
+        Geometry::Mesh(g) => {
+            if h.is_some() {
+                return Err(Error::model(
+                    "--h",
+                    "fem: applies to the built-in box geometry; a gmsh case is solved on its own mesh",
+                ));
+            }
+            let m = FemMesh::from_gmsh(g)?;
+            m.check_conforming()?;
+            m
+        }
+    };
+    let keys = crack_facets(&mesh, &spec.cracks)?;
+    let added = split(&mut mesh, &keys);
+    Ok((mesh, added))
+}
+
+/// Everything assembled for a FEM solve.
+pub struct FemModel {
+    /// The mesh, split along the cracks.
+    pub mesh: FemMesh,
+    /// Nodes added by the split.
+    pub split_nodes: usize,
+    /// K (with convection) and M.
+    pub system: System,
+    /// Held nodes and loads.
+    pub conditions: Conditions,
+    /// The nodes as an output cloud.
+    pub cloud: Cloud,
+    /// Flux recovery.
+    pub recovery: Recovery,
+    /// Initial temperature of every node (held values at t = 0 imposed), °C.
+    pub theta0: Vec<f64>,
+}
+
+impl FemModel {
+    /// Builds mesh, matrices and conditions of `case` (errors keyed as [`Error::Model`]).
+    pub fn build(case: &Case, h: Option<f64>) -> Result<FemModel> {
+        let spec = &case.spec;
+        let (mesh, split_nodes) = build_mesh(case, h)?;
+        let mut system = assemble(&mesh, &spec.materials);
+        let conditions = Conditions::build(&mesh, &spec.faces, spec.source.as_ref(), &mut system);
+        let (cloud, recovery) = output_cloud(&mesh, &system, &spec.materials);
+        let mut theta0: Vec<f64> = match &spec.initial {
+            Initial::Field(e) => mesh
+                .nodes
+                .iter()
+                .map(|p| e.eval(p.x, p.y, p.z, 0.0))
+                .collect(),
+            Initial::PerRegion(v) => cloud.region.iter().map(|&r| v[r as usize]).collect(),
+        };
+        if let Some(i) = theta0.iter().position(|v| !v.is_finite()) {
+            return Err(Error::model(
+                "initial",
+                format!("initial temperature is not finite at FEM node {i}"),
+            ));
+        }
+        conditions.impose(&mesh, 0.0, &mut theta0);
+        Ok(FemModel {
+            mesh,
+            split_nodes,
+            system,
+            conditions,
+            cloud,
+            recovery,
+            theta0,
+        })
+    }
+
+    /// Thermal energy Σ_i (Σ_j M_ij) θ_i = ∫ρcθ dV, J (relative to 0 °C).
+    pub fn energy(&self, theta: &[f64]) -> f64 {
+        self.system
+            .capacity
+            .iter()
+            .zip(theta)
+            .map(|(c, t)| c * t)
+            .sum()
+    }
+}
+
+/// Number of equal steps no longer than `dt` that cover `span`, s.
+pub fn steps_for(span: f64, dt: f64) -> u64 {
+    ((span / dt) * (1.0 - 1e-12)).ceil().max(1.0) as u64
+}
+
+fn keyed(case: &Case, e: Error) -> Error {
+    match e {
+        Error::Model { key, message } => Error::Case {
+            file: case.path.clone(),
+            key,
+            message,
+        },
+        Error::NonFinite { time, .. } => Error::Case {
+            file: case.path.clone(),
+            key: "state".into(),
+            message: format!("fem: temperature became non-finite by t = {time:e} s; check source and boundary values"),
+        },
+        other => other,
+    }
+}
+
+/// Runs `case` with the FEM solver into `out`; `progress(done, total)` reports steps.
+pub fn run_fem(
+    case: &Case,
+    out: &Path,
+    opts: &FemOptions,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunSummary> {
+    let t_setup = Instant::now();
+    let dt = opts.dt.unwrap_or_else(|| default_dt(case));
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(keyed(
+            case,
+            Error::model("--dt", format!("fem: must be a positive step, got {dt}")),
+        ));
+    }
+    let model = FemModel::build(case, opts.h).map_err(|e| keyed(case, e))?;
+    let mut stepper = Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme);
+    std::fs::create_dir_all(out).map_err(|error| Error::Io {
+        path: out.to_path_buf(),
+        error,
+    })?;
+    let setup_seconds = t_setup.elapsed().as_secs_f64();
+    let total: u64 = match opts.scheme {
+        Scheme::Steady => case.outputs.len() as u64,
+        _ => {
+            let mut t = 0.0;
+            case.outputs
+                .iter()
+                .map(|&to| {
+                    let n = steps_for(to - t, dt);
+                    t = to;
+                    n
+                })
+                .sum()
+        }
+    };
+    // crack facets for interpolating a reference table without looking across a crack (the
+    // geometry's own boundary sets hold a mesh's crack groups)
+    let cutters = match &case.reference {
+        Some(_) if !case.spec.cracks.is_empty() => {
+            crack_cutters(&case.spec.geometry.bare_cloud()?, &case.spec.cracks)
+        }
+        _ => Vec::new(),
+    };
+    let t_run = Instant::now();
+    let mut theta = model.theta0.clone();
+    let initial_energy = model.energy(&theta);
+    let mut flux = vec![Vector::zeros(); theta.len()];
+    let damage = vec![0.0; theta.len()];
+    let (mut energy, mut fields, mut comparisons) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut reference_seconds, mut steps, mut t) = (0.0, 0u64, 0.0);
+    for (k, &to) in case.outputs.iter().enumerate() {
+        if opts.scheme == Scheme::Steady {
+            stepper.steady(&mut theta, to).map_err(|e| keyed(case, e))?;
+            steps += 1;
+            progress(steps, total);
+        } else {
+            let n = steps_for(to - t, dt);
+            let h = (to - t) / n as f64;
+            for s in 0..n {
+                let now = if s + 1 == n { to - h } else { t + s as f64 * h };
+                stepper
+                    .step(&mut theta, now, h)
+                    .map_err(|e| keyed(case, e))?;
+                steps += 1;
+                progress(steps, total);
+            }
+        }
+        t = to;
+        energy.push(model.energy(&theta));
+        model.recovery.flux(&model.mesh, &theta, &mut flux);
+        let classical = match &case.reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, to, &cutters)?;
+                comparisons.push(compare(&model.cloud, &theta, &classical, r, to));
+                reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
+        };
+        let f = Fields {
+            theta: &theta,
+            damage: &damage,
+            flux: &flux,
+            reference: classical.as_deref(),
+        };
+        let path = field_path(out, k + 1);
+        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic(
+            &vtu_path(out, k + 1),
+            field_vtu(&model.cloud, &f).as_bytes(),
+        )?;
+        fields.push(format!("field_{}.csv", k + 1));
+    }
+    let summary = RunSummary {
+        title: case.title.clone(),
+        case: case.path.display().to_string(),
+        solver: "fem".into(),
+        nodes: model.cloud.n_body,
+        fictitious_nodes: 0,
+        bonds: 0,
+        pairs: model.system.cols.len(),
+        steps,
+        dt: if opts.scheme == Scheme::Steady {
+            0.0
+        } else {
+            dt
+        },
+        dt_stable: 0.0,
+        integrator: opts.scheme.name().into(),
+        output_times: case.outputs.clone(),
+        fields,
+        initial_energy,
+        energy,
+        setup_seconds,
+        wall_seconds: t_run.elapsed().as_secs_f64() - reference_seconds,
+        reference_seconds,
+        threads: rayon::current_num_threads(),
+        consistency: None,
+        reference: comparisons,
+    };
+    summary.write(out)?;
+    Ok(summary)
+}
