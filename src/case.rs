@@ -10,6 +10,8 @@ use crate::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
 use crate::crack::Growth;
 use crate::error::{Error, Result};
 use crate::expr::Expr;
+use crate::fem::run::FemOptions;
+use crate::fem::solve::Scheme;
 use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use crate::material::{BondRule, Material};
 use crate::math::Point;
@@ -324,15 +326,36 @@ pub struct ReferenceSection {
     /// A CSV table exported by another code (path relative to the case file).
     #[serde(default)]
     pub file: Option<PathBuf>,
+    /// The built-in classical FEM solve of the same case.
+    #[serde(default)]
+    pub fem: Option<FemReferenceSpec>,
     /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`, m.
     #[serde(default)]
     pub line_y: Option<f64>,
     /// A vertical probe line x = `line_x` for the report's plots (seed 004 §4.3), m.
     #[serde(default)]
     pub line_x: Option<f64>,
+    /// Leave the nodes within this distance of a crack tip out of the measures, m.
+    #[serde(default)]
+    pub exclude_tips: Option<f64>,
     /// A point whose nearest body node is reported at every output (e.g. seed 000's midpoint), m.
     #[serde(default)]
     pub probe: Option<Vec<f64>>,
+}
+
+/// `[reference.fem]`: settings of the built-in FEM reference (see `peritherm fem`).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FemReferenceSpec {
+    /// Element size of a box case's structured mesh, m (default: the finest region spacing).
+    #[serde(default)]
+    pub h: Option<f64>,
+    /// `crank_nicolson` (default), `backward_euler` or `steady`.
+    #[serde(default)]
+    pub scheme: Option<Scheme>,
+    /// Time step, s (default: min(end/1000, first output/100)).
+    #[serde(default)]
+    pub dt: Option<f64>,
 }
 
 /// Where the classical temperatures of a reference come from.
@@ -342,6 +365,8 @@ pub enum ReferenceSource {
     Analytic(Reference),
     /// A table exported by another code, interpolated at the nodes.
     Table(Arc<ReferenceTable>),
+    /// The built-in FEM solve of the same case (run first, then used as a table).
+    Fem(FemOptions),
 }
 
 /// A validated reference: its source and where to compare.
@@ -353,6 +378,8 @@ pub struct ReferenceSpec {
     pub line_y: Option<f64>,
     /// Vertical probe line x = line_x of the report, m.
     pub line_x: Option<f64>,
+    /// Nodes within this distance of a crack tip are left out of the measures, m (0: none).
+    pub exclude_tips: f64,
     /// The point whose nearest body node is reported, m.
     pub probe: Option<Point>,
 }
@@ -441,9 +468,21 @@ fn reference(
             ));
         }
     }
-    let source = match (r.solution, r.file) {
-        (Some(s), None) => ReferenceSource::Analytic(s),
-        (None, Some(file)) => {
+    let source = match (r.solution, r.file, r.fem) {
+        (Some(s), None, None) => ReferenceSource::Analytic(s),
+        (None, None, Some(f)) => {
+            for (key, v) in [("reference.fem.h", f.h), ("reference.fem.dt", f.dt)] {
+                if let Some(v) = v {
+                    positive(path, key, v)?;
+                }
+            }
+            ReferenceSource::Fem(FemOptions {
+                h: f.h,
+                scheme: f.scheme.unwrap_or(Scheme::CrankNicolson),
+                dt: f.dt,
+            })
+        }
+        (None, Some(file), None) => {
             let file = path.parent().unwrap_or(Path::new(".")).join(file);
             let table = ReferenceTable::read(&file, dim)?;
             table
@@ -455,7 +494,7 @@ fn reference(
             return Err(case_err(
                 path,
                 "reference",
-                "give exactly one of `solution` (analytical) or `file` (a CSV table)",
+                "give exactly one of `solution` (analytical), `file` (a CSV table) or `fem` (the built-in FEM solve)",
             ))
         }
     };
@@ -463,6 +502,10 @@ fn reference(
         source,
         line_y: r.line_y,
         line_x: r.line_x,
+        exclude_tips: match r.exclude_tips {
+            Some(v) => positive(path, "reference.exclude_tips", v)?,
+            None => 0.0,
+        },
         probe,
     })
 }

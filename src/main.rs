@@ -505,6 +505,7 @@ fn report(inputs: &[PathBuf], out: &std::path::Path, quiet: bool) -> anyhow::Res
         let reference = match case.reference.as_ref().map(|r| &r.source) {
             Some(ReferenceSource::Analytic(_)) => "series",
             Some(ReferenceSource::Table(_)) => "reference table",
+            Some(ReferenceSource::Fem(_)) => "FEM",
             None => "none",
         };
         let w = write_report(&case, &run, &dir, reference)?;

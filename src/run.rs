@@ -1,14 +1,19 @@
 //! Running a case end to end: build, integrate, write fields and the summary.
 
-use crate::case::Case;
+use crate::case::{Case, ReferenceSource, ReferenceSpec};
+use crate::crack::tips_at;
 use crate::error::{Error, Result};
+use crate::fem::run_fem;
 use crate::model::crack_cutters;
 use crate::model::Model;
+use crate::output::read_field;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
+use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
 use crate::solve::explicit::{choose_dt, count_steps, Explicit, Integrator};
 use crate::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Runs `case`, writing its outputs into `out`; `progress(done, total)` reports steps.
@@ -65,16 +70,20 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let mut reference_seconds = 0.0;
     let t_run = Instant::now();
     let cutters = crack_cutters(&model.cloud, &case.spec.cracks);
+    let started = Instant::now();
+    let reference = resolve_reference(case, out)?;
+    let fem_seconds = started.elapsed().as_secs_f64();
     let on_output = |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance| {
         energy.push(model.energy(th));
         let path = field_path(out, k + 1);
         let flux = conductance.flux(&model.cloud, th);
         let damage = model.damage_at(t);
-        let classical = match &case.reference {
+        let classical = match &reference {
             Some(r) => {
                 let started = Instant::now();
                 let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                comparisons.push(compare(&model.cloud, th, &classical, r, t));
+                let tips = tips_at(&cutters, t);
+                comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
                 reference_seconds += started.elapsed().as_secs_f64();
                 Some(classical)
             }
@@ -152,7 +161,7 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         energy,
         setup_seconds,
         wall_seconds: t_run.elapsed().as_secs_f64() - reference_seconds,
-        reference_seconds,
+        reference_seconds: reference_seconds + fem_seconds,
         threads: rayon::current_num_threads(),
         consistency: model
             .correction
@@ -161,4 +170,35 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// The case's reference ready for comparison: a `[reference.fem]` is solved first (by
+/// `peritherm fem`'s solver, into `out/fem/`) and its fields become a reference table.
+pub fn resolve_reference(case: &Case, out: &Path) -> Result<Option<ReferenceSpec>> {
+    let Some(r) = &case.reference else {
+        return Ok(None);
+    };
+    let ReferenceSource::Fem(opts) = &r.source else {
+        return Ok(Some(r.clone()));
+    };
+    let dir = out.join("fem");
+    let summary = run_fem(case, &dir, opts, |_, _| {})?;
+    let mut snapshots = Vec::new();
+    for (t, f) in summary.output_times.iter().zip(&summary.fields) {
+        let rows = read_field(&dir.join(f))?;
+        snapshots.push(Snapshot {
+            time: *t,
+            pos: rows.pos,
+            theta: rows.theta,
+        });
+    }
+    let table = ReferenceTable {
+        path: dir,
+        dim: case.spec.geometry.bare_cloud()?.dim,
+        snapshots,
+    };
+    Ok(Some(ReferenceSpec {
+        source: ReferenceSource::Table(Arc::new(table)),
+        ..r.clone()
+    }))
 }

@@ -437,13 +437,16 @@ pub fn run(
     Ok(rows)
 }
 
+/// The abscissa of a convergence plot: a row's value on it, if any.
+type Axis = Box<dyn Fn(&Row) -> Option<f64>>;
+
 /// Convergence plots of a sweep into `out`, one per output time: the max difference (and
 /// eq 13 where there is one) against each varied key whose values are positive numbers, and
 /// against the smallest horizon δ when it varies, on log–log axes with fitted rates (seed 000
 /// Figs 10–12, seed 003 Figs 11–12). Returns the stems written and the fitted rates as
 /// (stem, series, rate).
 pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
-    let mut axes: Vec<(String, Box<dyn Fn(&Row) -> Option<f64>>)> = Vec::new();
+    let mut axes: Vec<(String, Axis)> = Vec::new();
     let keys: Vec<String> = rows
         .first()
         .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())

@@ -195,7 +195,7 @@ fn measures_follow_the_formulas() {
     let mut r = r.clone();
     r.line_y = None;
     r.probe = Some(peritherm::math::Point::new(5.4, 0.0, 0.0));
-    let c = compare(&model.cloud, &pd, &exact, &r, 1.0);
+    let c = compare(&model.cloud, &pd, &exact, &r, 1.0, &[]);
     let probe = c.probe.unwrap();
     assert!(
         (probe.x - 5.5).abs() < 1e-12 && (probe.peridynamic / probe.classical - 1.01).abs() < 1e-12

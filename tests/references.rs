@@ -65,7 +65,7 @@ fn series_csv(n: usize, times: &[f64]) -> String {
         .source
     {
         ReferenceSource::Analytic(r) => r,
-        ReferenceSource::Table(_) => unreachable!(),
+        _ => unreachable!("SERIES is an analytical reference"),
     };
     let mut s = String::from("# the square series\nx,y,time,temperature\n");
     for &t in times {
@@ -180,6 +180,44 @@ fn bad_tables_are_named() {
         .to_string();
     assert!(
         e.contains("ref.csv: t = 0.05: does not cover the node at"),
+        "{e}"
+    );
+}
+
+/// `[reference.fem]` solves the case with the built-in FEM first (into `<out>/fem/`) and
+/// compares the PD run with it. On the coarse square (32 × 32 nodes, δ = 3Δ) the PD error
+/// against the series is 1.04 / 0.81 °C at t = 0.05 / 0.1 s and the FEM's (quads of h = 1/32,
+/// Crank–Nicolson) 0.046 / 0.023 °C (both measured with `peritherm run` and `peritherm fem`),
+/// so judged against the FEM the PD run must show the same max difference to within the FEM
+/// error plus the interpolation of its field at the PD nodes: 0.2 °C.
+#[test]
+fn a_fem_reference_is_solved_and_compared() {
+    let dir = tempfile::tempdir().unwrap();
+    let with = |reference: &str| {
+        let case = Case::parse(&square(reference), &dir.path().join("f.toml")).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let s = peritherm::run::run_case(&case, out.path(), |_, _| {}).unwrap();
+        (s, out)
+    };
+    let (fem, out) = with("[reference.fem]\nh = 0.03125\nscheme = \"crank_nicolson\"");
+    assert!(out.path().join("fem/run.json").exists());
+    let (series, _) = with(SERIES);
+    assert_eq!(fem.reference.len(), 2);
+    for (f, s) in fem.reference.iter().zip(&series.reference) {
+        eprintln!(
+            "t = {}: PD against FEM {:.3} °C, against the series {:.3} °C",
+            f.time, f.max_abs_diff, s.max_abs_diff
+        );
+        assert!((f.max_abs_diff - s.max_abs_diff).abs() < 0.2, "{f:?} {s:?}");
+    }
+    let e = Case::parse(
+        &square("[reference.fem]\nh = -1.0"),
+        &dir.path().join("f.toml"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("reference.fem.h: must be a positive number"),
         "{e}"
     );
 }

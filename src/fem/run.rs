@@ -9,6 +9,7 @@ use super::mesh::FemMesh;
 use super::solve::{Scheme, Stepper};
 use super::split::{check_cracks, crack_facets, split};
 use crate::case::Case;
+use crate::case::ReferenceSource;
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
 use crate::math::Vector;
@@ -198,7 +199,12 @@ pub fn run_fem(
     };
     // crack facets for interpolating a reference table without looking across a crack (the
     // geometry's own boundary sets hold a mesh's crack groups)
-    let cutters = match &case.reference {
+    // a case whose reference is this FEM solve has nothing to compare with here
+    let reference = case
+        .reference
+        .as_ref()
+        .filter(|r| !matches!(r.source, ReferenceSource::Fem(_)));
+    let cutters = match reference {
         Some(_) if !case.spec.cracks.is_empty() => {
             crack_cutters(&case.spec.geometry.bare_cloud()?, &case.spec.cracks)
         }
@@ -231,11 +237,12 @@ pub fn run_fem(
         t = to;
         energy.push(model.energy(&theta));
         model.recovery.flux(&model.mesh, &theta, &mut flux);
-        let classical = match &case.reference {
+        let classical = match reference {
             Some(r) => {
                 let started = Instant::now();
                 let classical = classical_at(&model.cloud, &r.source, to, &cutters)?;
-                comparisons.push(compare(&model.cloud, &theta, &classical, r, to));
+                let tips = crate::crack::tips_at(&cutters, to);
+                comparisons.push(compare(&model.cloud, &theta, &classical, r, to, &tips));
                 reference_seconds += started.elapsed().as_secs_f64();
                 Some(classical)
             }

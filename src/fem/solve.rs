@@ -78,7 +78,8 @@ impl Factor {
 }
 
 /// Time discretisation of the FEM solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Scheme {
     /// Backward Euler: first order in time, L-stable (no oscillations after jumps).
     BackwardEuler,

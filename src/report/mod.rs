@@ -29,6 +29,10 @@ pub fn classical_at(
             let points: Vec<(f64, f64)> = nodes.iter().map(|p| (p.x, p.y)).collect();
             Ok(r.eval_many(&points, t))
         }
+        ReferenceSource::Fem(_) => Err(Error::model(
+            "reference.fem",
+            "the FEM reference is solved (run::resolve_reference) before it is compared",
+        )),
         ReferenceSource::Table(table) => {
             let bad = |message: String| Error::Case {
                 file: table.path.clone(),
@@ -60,14 +64,17 @@ pub fn classical_at(
 /// Compares the body temperatures `theta` with the classical ones `classical` (at the body
 /// nodes, from [`classical_at`]) at time `t`: over all nodes, along the probe line
 /// y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the body node nearest to
-/// the probe point.
+/// the probe point. Nodes within `spec.exclude_tips` of a point of `tips` are left out.
 pub fn compare(
     cloud: &Cloud,
     theta: &[f64],
     classical: &[f64],
     spec: &ReferenceSpec,
     t: f64,
+    tips: &[Point],
 ) -> Comparison {
+    let r = spec.exclude_tips;
+    let skip = |i: usize| r > 0.0 && tips.iter().any(|c| (cloud.pos[i] - c).norm() < r);
     let line_y = spec.line_y;
     let n = cloud.n_body;
     let probe = spec.probe.and_then(|target| {
@@ -88,7 +95,12 @@ pub fn compare(
     let (mut sq_rel, mut n_rel) = (0.0, 0usize);
     let (mut sq, mut cmax) = (0.0, 0.0f64);
     let (mut num, mut den, mut n_line) = (0.0, 0.0, 0usize);
+    let mut n_kept = 0usize;
     for i in 0..n {
+        if skip(i) {
+            continue;
+        }
+        n_kept += 1;
         let (c, p) = (classical[i], theta[i]);
         let d = c - p;
         max_abs = max_abs.max(d.abs());
@@ -118,7 +130,7 @@ pub fn compare(
         },
         l2_rel_line: if den > 0.0 { (num / den).sqrt() } else { 0.0 },
         epsilon: if cmax > 0.0 {
-            (sq / n as f64).sqrt() / cmax
+            (sq / n_kept.max(1) as f64).sqrt() / cmax
         } else {
             0.0
         },
