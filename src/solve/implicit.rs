@@ -516,11 +516,15 @@ impl<'a> Implicit<'a> {
         let (chol, lu, stack) = match options.solver {
             Solver::Cg => (None, None, MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
             Solver::Direct if sys.symmetric => {
-                let (fwd, inv) = nested_dissection(&sys, model);
-                let ordering = if options.ordering == Ordering::NestedDissection {
-                    SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
-                } else {
-                    SymmetricOrdering::Amd
+                let (fwd, inv) = match options.ordering {
+                    Ordering::NestedDissection => nested_dissection(&sys, model),
+                    Ordering::Amd => (Vec::new(), Vec::new()),
+                };
+                let ordering = match options.ordering {
+                    Ordering::NestedDissection => {
+                        SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+                    }
+                    Ordering::Amd => SymmetricOrdering::Amd,
                 };
                 let s = factorize_symbolic_cholesky(
                     symbolic,
