@@ -432,6 +432,40 @@ impl Boundary {
         d
     }
 
+    /// The linear part of every constraint, in the order [`Boundary::apply`] sets them:
+    /// `(node, [(source, weight)])` with θ_node = Σ weight·θ_source + (a part that depends on t
+    /// only: `apply` on a field whose free nodes are 0 gives it). Formulation §3; the implicit
+    /// solvers eliminate constrained and fictitious nodes with it.
+    pub fn linear_rules(&self) -> Vec<(usize, Vec<(usize, f64)>)> {
+        let mut out = Vec::new();
+        for n in &self.nodal {
+            out.extend(n.nodes.iter().map(|&i| (i, Vec::new())));
+        }
+        for r in &self.relation1d {
+            out.extend(r.slaved.iter().map(|&(i, _)| (i, vec![(r.anchor, 1.0)])));
+        }
+        for r in &self.relation_nodal {
+            let s = r
+                .stencil
+                .iter()
+                .map(|&(j, w)| (j as usize, w / r.wsum))
+                .collect();
+            out.push((r.node, s));
+        }
+        for g in &self.ghosts {
+            let s = if g.sigma != 0.0 {
+                g.stencil
+                    .iter()
+                    .map(|&(j, w)| (j as usize, g.sigma * w))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            out.push((g.node, s));
+        }
+        out
+    }
+
     /// True when convection or a source adds to the rates.
     pub fn has_loads(&self) -> bool {
         !self.convective.is_empty() || self.source.is_some()

@@ -49,6 +49,12 @@ pub enum Error {
         /// Simulation time, s.
         time: f64,
     },
+    /// A linear solve of the implicit or steady solvers failed (formulation §4).
+    #[error("linear solver: {message}")]
+    Solver {
+        /// What failed and why.
+        message: String,
+    },
     /// A mesh file that cannot be read or does not describe a usable body.
     #[error("{path}: {message}")]
     Mesh {

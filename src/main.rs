@@ -296,17 +296,36 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             let model =
                 Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
             let bound = case.integrator.stable_dt(&model);
-            say!(
-                "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
-                case.path.display(),
-                model.cloud.n_body,
-                model.cloud.n_fictitious(),
-                model.horizons.n_bonds(),
-                case.integrator.name(),
-                bound
-            );
-            if let Err(e) = choose_dt(&model, case.integrator, case.dt) {
-                anyhow::bail!("{}: time.dt: {e}", case.path.display());
+            if case.integrator.is_implicit() {
+                say!(
+                    "{}: {} body nodes, {} fictitious, {} directed bonds, {}: no stability bound (explicit Euler's would be {:.4e} s)",
+                    case.path.display(),
+                    model.cloud.n_body,
+                    model.cloud.n_fictitious(),
+                    model.horizons.n_bonds(),
+                    case.integrator.name(),
+                    peritherm::solve::explicit::Integrator::Euler.stable_dt(&model)
+                );
+                if let Err(e) = peritherm::solve::implicit::System::build(&model) {
+                    anyhow::bail!("{}: {e}", case.path.display());
+                }
+            } else {
+                say!(
+                    "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
+                    case.path.display(),
+                    model.cloud.n_body,
+                    model.cloud.n_fictitious(),
+                    model.horizons.n_bonds(),
+                    case.integrator.name(),
+                    bound
+                );
+            }
+            match choose_dt(&model, case.integrator, case.dt) {
+                Err(peritherm::Error::Model { key, message }) => {
+                    anyhow::bail!("{}: {key}: {message}", case.path.display())
+                }
+                Err(e) => anyhow::bail!("{}: time.dt: {e}", case.path.display()),
+                Ok(_) => {}
             }
             Ok(())
         }

@@ -10,7 +10,8 @@ use crate::output::read_field;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
-use crate::solve::explicit::{choose_dt, count_steps, Explicit};
+use crate::solve::explicit::{choose_dt, count_steps, Explicit, Integrator};
+use crate::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -26,20 +27,41 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         },
         other => other,
     })?;
-    let dt = choose_dt(&model, case.integrator, case.dt).map_err(|e| match e {
+    let in_case = |e: Error| match e {
         Error::UnstableDt { .. } => Error::Case {
             file: case.path.clone(),
             key: "time.dt".into(),
             message: e.to_string(),
         },
+        Error::Model { key, message } => Error::Case {
+            file: case.path.clone(),
+            key,
+            message,
+        },
         other => other,
-    })?;
+    };
+    let dt = choose_dt(&model, case.integrator, case.dt).map_err(in_case)?;
+    let scheme = match case.integrator {
+        Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
+        Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
+        Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
+        Integrator::Euler | Integrator::Rk4 => None,
+    };
+    // the implicit system (elimination, symbolic factorisation) is part of the set-up
+    let mut implicit = match scheme {
+        Some(s) => Some(Implicit::new(&model, s, Options::default()).map_err(in_case)?),
+        None => None,
+    };
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     std::fs::create_dir_all(out).map_err(|error| Error::Io {
         path: out.to_path_buf(),
         error,
     })?;
-    let total = count_steps(0.0, &case.outputs, dt);
+    let total = if case.integrator == Integrator::Steady {
+        0
+    } else {
+        count_steps(0.0, &case.outputs, dt)
+    };
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let mut energy = Vec::new();
@@ -51,47 +73,58 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let started = Instant::now();
     let reference = resolve_reference(case, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
-    let mut stepper = Explicit::new(&model, case.integrator);
-    let stats = stepper.run(
-        &mut theta,
-        0.0,
-        dt,
-        &case.outputs,
-        |k, t, th, conductance| {
-            energy.push(model.energy(th));
-            let path = field_path(out, k + 1);
-            let flux = conductance.flux(&model.cloud, th);
-            let damage = model.damage_at(t);
-            let classical = match &reference {
-                Some(r) => {
-                    let started = Instant::now();
-                    let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                    let tips = tips_at(&cutters, t);
-                    comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
-                    reference_seconds += started.elapsed().as_secs_f64();
-                    Some(classical)
-                }
-                None => None,
-            };
-            let f = Fields {
-                theta: th,
-                damage: &damage,
-                flux: &flux,
-                reference: classical.as_deref(),
-            };
-            write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-            write_atomic(&vtu_path(out, k + 1), field_vtu(&model.cloud, &f).as_bytes())?;
-            fields.push(
-                path.file_name()
-                    .expect("file")
-                    .to_string_lossy()
-                    .into_owned(),
-            );
-            Ok(())
-        },
-        |s| progress(s, total),
-    )
-    .map_err(|e| match e {
+    let on_output = |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance| {
+        energy.push(model.energy(th));
+        let path = field_path(out, k + 1);
+        let flux = conductance.flux(&model.cloud, th);
+        let damage = model.damage_at(t);
+        let classical = match &reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                let tips = tips_at(&cutters, t);
+                comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
+                reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
+        };
+        let f = Fields {
+            theta: th,
+            damage: &damage,
+            flux: &flux,
+            reference: classical.as_deref(),
+        };
+        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic(
+            &vtu_path(out, k + 1),
+            field_vtu(&model.cloud, &f).as_bytes(),
+        )?;
+        fields.push(
+            path.file_name()
+                .expect("file")
+                .to_string_lossy()
+                .into_owned(),
+        );
+        Ok(())
+    };
+    let result = match implicit.as_mut() {
+        Some(stepper) if case.integrator == Integrator::Steady => {
+            stepper.steady(&mut theta, &case.outputs, on_output)
+        }
+        Some(stepper) => stepper.run(&mut theta, 0.0, dt, &case.outputs, on_output, |s| {
+            progress(s, total)
+        }),
+        None => Explicit::new(&model, case.integrator).run(
+            &mut theta,
+            0.0,
+            dt,
+            &case.outputs,
+            on_output,
+            |s| progress(s, total),
+        ),
+    };
+    let stats = result.map_err(|e| match e {
         Error::NonFinite { node, time } => {
             let p = model.cloud.pos[node];
             Error::Case {
@@ -114,8 +147,13 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         bonds: model.horizons.n_bonds(),
         pairs: model.conductance.nnz(),
         steps: stats.steps,
-        dt,
-        dt_stable: case.integrator.stable_dt(&model),
+        // implicit runs: the step taken (0 for steady) and, for comparison, Euler's bound
+        dt: if dt.is_finite() { dt } else { 0.0 },
+        dt_stable: if case.integrator.is_implicit() {
+            Integrator::Euler.stable_dt(&model)
+        } else {
+            case.integrator.stable_dt(&model)
+        },
         integrator: case.integrator.name().into(),
         output_times: case.outputs.clone(),
         fields,

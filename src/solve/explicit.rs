@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
-/// Explicit integrator.
+/// Time integrator of `time.integrator`: the explicit ones here, the implicit ones and the
+/// steady solve in [`crate::solve::implicit`] (formulation §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Integrator {
@@ -19,6 +20,14 @@ pub enum Integrator {
     Euler,
     /// Classical fourth-order Runge–Kutta, stable for Δt ≤ 2.78/λ_max.
     Rk4,
+    /// Backward Euler (implicit, first order, no stability bound).
+    BackwardEuler,
+    /// Crank–Nicolson (implicit, second order, no stability bound).
+    CrankNicolson,
+    /// BDF2 (implicit, second order, no stability bound).
+    Bdf2,
+    /// Steady state A θ = f(t) at each output time (no time stepping).
+    Steady,
 }
 
 impl Integrator {
@@ -27,13 +36,23 @@ impl Integrator {
         match self {
             Integrator::Euler => "euler",
             Integrator::Rk4 => "rk4",
+            Integrator::BackwardEuler => "backward_euler",
+            Integrator::CrankNicolson => "crank_nicolson",
+            Integrator::Bdf2 => "bdf2",
+            Integrator::Steady => "steady",
         }
     }
-    /// Stability-region extent on the negative real axis (formulation §4).
+    /// True for the implicit schemes and the steady solve ([`crate::solve::implicit`]).
+    pub fn is_implicit(&self) -> bool {
+        !matches!(self, Integrator::Euler | Integrator::Rk4)
+    }
+    /// Stability-region extent on the negative real axis (formulation §4); infinite for the
+    /// implicit schemes (A-stable).
     pub fn stability(&self) -> f64 {
         match self {
             Integrator::Euler => 2.0,
             Integrator::Rk4 => 2.78,
+            _ => f64::INFINITY,
         }
     }
     /// Largest stable step for a model, s.
@@ -54,8 +73,24 @@ pub struct RunStats {
     pub steps: u64,
 }
 
-/// Chooses the step: the user's (checked against the bound) or 0.95 of the bound.
+/// Chooses the step: the user's (checked against the bound) or 0.95 of the bound; implicit
+/// integrators need the user's step (no bound), the steady solve none (infinite).
 pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Result<f64> {
+    if integrator == Integrator::Steady {
+        return Ok(f64::INFINITY);
+    }
+    if integrator.is_implicit() {
+        return match user {
+            Some(dt) => Ok(dt),
+            None => Err(Error::model(
+                "time.dt",
+                format!(
+                    "is required for the implicit integrator {} (no stability bound to default to)",
+                    integrator.name()
+                ),
+            )),
+        };
+    }
     let bound = integrator.stable_dt(model);
     match user {
         Some(dt) if dt > bound => Err(Error::UnstableDt {
@@ -131,8 +166,8 @@ impl<'a> Explicit<'a> {
     pub fn new(model: &'a Model, integrator: Integrator) -> Self {
         let nb = model.cloud.n_body;
         let stages = match integrator {
-            Integrator::Euler => 1,
             Integrator::Rk4 => 4,
+            _ => 1,
         };
         let k = std::array::from_fn(|s| {
             if s < stages {
@@ -177,12 +212,22 @@ impl<'a> Explicit<'a> {
 
     /// Advances `theta` (all nodes) from t to t + h, constraints included; growing cracks
     /// cut the bonds their tips have passed by t first.
+    ///
+    /// # Panics
+    /// If built with an implicit integrator (those run through [`crate::solve::implicit`];
+    /// `run_case` dispatches them there).
     pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
         self.cut_until(t);
         let m = self.model;
         let k = &*self.conductance;
         let nb = m.cloud.n_body;
         match self.integrator {
+            Integrator::BackwardEuler
+            | Integrator::CrankNicolson
+            | Integrator::Bdf2
+            | Integrator::Steady => {
+                panic!("implicit integrators run through solve::implicit, not Explicit")
+            }
             Integrator::Euler => {
                 rates(m, k, theta, t, &mut self.k[0]);
                 theta[..nb]

@@ -1,3 +1,4 @@
 //! Time integration of formulation eq (1).
 
 pub mod explicit;
+pub mod implicit;
