@@ -199,15 +199,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 summary.wall_seconds,
                 out.display()
             );
-            for c in &summary.reference {
-                say!(
-                    "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
-                    c.time,
-                    c.max_abs_diff,
-                    c.mean_sq_rel_diff,
-                    c.l2_rel_line
-                );
-            }
+            print_comparisons(&summary);
             Ok(())
         }
         Command::Fem {
@@ -252,15 +244,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 summary.setup_seconds,
                 out.display()
             );
-            for c in &summary.reference {
-                say!(
-                    "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
-                    c.time,
-                    c.max_abs_diff,
-                    c.mean_sq_rel_diff,
-                    c.l2_rel_line
-                );
-            }
+            print_comparisons(&summary);
             Ok(())
         }
         Command::Table { runs } => {
@@ -329,6 +313,19 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
+    }
+}
+
+/// Prints a run's comparison with its reference, one line per output time.
+fn print_comparisons(summary: &RunSummary) {
+    for c in &summary.reference {
+        say!(
+            "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
+            c.time,
+            c.max_abs_diff,
+            c.mean_sq_rel_diff,
+            c.l2_rel_line
+        );
     }
 }
 

@@ -24,6 +24,24 @@ pub enum Initial {
     PerRegion(Vec<f64>),
 }
 
+impl Initial {
+    /// The initial temperature at points `pos` of regions `region`, °C; `what` names the
+    /// points in the error for a non-finite value ("node", "FEM node").
+    pub fn at(&self, pos: &[Point], region: &[u16], what: &str) -> Result<Vec<f64>> {
+        let theta0: Vec<f64> = match self {
+            Initial::Field(e) => pos.iter().map(|p| e.eval(p.x, p.y, p.z, 0.0)).collect(),
+            Initial::PerRegion(v) => region.iter().map(|&r| v[r as usize]).collect(),
+        };
+        match theta0.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(Error::model(
+                "initial",
+                format!("initial temperature is not finite at {what} {i}"),
+            )),
+            None => Ok(theta0),
+        }
+    }
+}
+
 /// Where the nodes come from.
 #[derive(Debug, Clone)]
 pub enum Geometry {
@@ -335,20 +353,7 @@ impl Model {
         let inv_heat_capacity = (0..cloud.n_body)
             .map(|i| 1.0 / (cloud.volume[i] * capacity[i]))
             .collect();
-        let mut theta0: Vec<f64> = match &spec.initial {
-            Initial::Field(e) => cloud
-                .pos
-                .iter()
-                .map(|p| e.eval(p.x, p.y, p.z, 0.0))
-                .collect(),
-            Initial::PerRegion(v) => cloud.region.iter().map(|&r| v[r as usize]).collect(),
-        };
-        if let Some(i) = theta0.iter().position(|v| !v.is_finite()) {
-            return Err(Error::model(
-                "initial",
-                format!("initial temperature is not finite at node {i}"),
-            ));
-        }
+        let mut theta0 = spec.initial.at(&cloud.pos, &cloud.region, "node")?;
         boundary.apply(&cloud, &mut theta0, 0.0);
         Ok(Model {
             cloud,

@@ -437,6 +437,14 @@ pub fn run(
     Ok(rows)
 }
 
+/// The last component of `path` as text.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned()
+}
+
 /// The abscissa of a convergence plot: a row's value on it, if any.
 type Axis = Box<dyn Fn(&Row) -> Option<f64>>;
 
@@ -524,11 +532,7 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
                 &series,
                 Legend::LowerRight,
             )?;
-            let stem = stem
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned();
+            let stem = file_name(&stem);
             for (s, law) in series.iter().zip(laws) {
                 fitted.push((stem.clone(), s.name.clone(), law.rate));
             }
@@ -651,12 +655,7 @@ pub fn line_plots(
                     &diffs,
                     Legend::UpperLeft,
                 )?;
-                stems.push(
-                    stem.file_name()
-                        .unwrap_or_default()
-                        .to_string_lossy()
-                        .into_owned(),
-                );
+                stems.push(file_name(&stem));
             }
             let stem = out.join(format!("lines_{}_t{}", line.slug(), k + 1));
             line_plot(
@@ -669,12 +668,7 @@ pub fn line_plots(
                 &series,
                 Legend::UpperLeft,
             )?;
-            stems.push(
-                stem.file_name()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .into_owned(),
-            );
+            stems.push(file_name(&stem));
         }
     }
     Ok(stems)

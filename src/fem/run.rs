@@ -13,7 +13,7 @@ use crate::case::ReferenceSource;
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
 use crate::math::Vector;
-use crate::model::{crack_cutters, Geometry, Initial};
+use crate::model::{crack_cutters, Geometry};
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
 use crate::report::{classical_at, compare};
 use std::path::Path;
@@ -103,20 +103,7 @@ impl FemModel {
         let mut system = assemble(&mesh, &spec.materials);
         let conditions = Conditions::build(&mesh, &spec.faces, spec.source.as_ref(), &mut system);
         let (cloud, recovery) = output_cloud(&mesh, &system, &spec.materials);
-        let mut theta0: Vec<f64> = match &spec.initial {
-            Initial::Field(e) => mesh
-                .nodes
-                .iter()
-                .map(|p| e.eval(p.x, p.y, p.z, 0.0))
-                .collect(),
-            Initial::PerRegion(v) => cloud.region.iter().map(|&r| v[r as usize]).collect(),
-        };
-        if let Some(i) = theta0.iter().position(|v| !v.is_finite()) {
-            return Err(Error::model(
-                "initial",
-                format!("initial temperature is not finite at FEM node {i}"),
-            ));
-        }
+        let mut theta0 = spec.initial.at(&mesh.nodes, &cloud.region, "FEM node")?;
         conditions.impose(&mesh, 0.0, &mut theta0);
         Ok(FemModel {
             mesh,
