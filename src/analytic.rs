@@ -83,6 +83,19 @@ pub enum Reference {
         /// Initial θ, °C.
         initial: f64,
     },
+    /// Sphere of radius R about the origin, surface held, uniform initial temperature
+    /// (seed 001 §3.2): θ = θ_s + (θ_0 − θ_s)(2R/(πr)) Σ (−1)^(n+1)/n sin(nπr/R)
+    /// e^(−α n²π² t/R²), r = √(x² + y²) (the radius of a 1D radial model is x).
+    SphereFixedSurface {
+        /// Radius R, m.
+        radius: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ on the surface, °C (or K).
+        surface: f64,
+        /// Initial θ, °C (or K).
+        initial: f64,
+    },
     /// Steady conduction in a ring about the origin with both circles held:
     /// θ = θ_i + (θ_o − θ_i) ln(r/r_i)/ln(r_o/r_i) (independent of t).
     AnnulusSteady {
@@ -124,7 +137,9 @@ impl Reference {
     pub fn depends_on_y(&self) -> bool {
         matches!(
             self,
-            Reference::SquareFixedEdges { .. } | Reference::AnnulusSteady { .. }
+            Reference::SquareFixedEdges { .. }
+                | Reference::AnnulusSteady { .. }
+                | Reference::SphereFixedSurface { .. }
         )
     }
 
@@ -160,6 +175,28 @@ impl Reference {
     /// The classical temperature at a point and time, °C.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
         match *self {
+            Reference::SphereFixedSurface {
+                radius: rs,
+                diffusivity: a,
+                surface,
+                initial,
+            } => {
+                let r = x.hypot(y).min(rs);
+                let c = PI / rs;
+                let mut sum = 0.0;
+                for n in 1..=terms(a, t, c) {
+                    let lam = c * n as f64;
+                    let sign = if n % 2 == 1 { 1.0 } else { -1.0 };
+                    // sin(λr)/(λr) → 1 at the centre
+                    let sinc = if lam * r < 1e-8 {
+                        1.0
+                    } else {
+                        (lam * r).sin() / (lam * r)
+                    };
+                    sum += 2.0 * sign * sinc * (-a * lam * lam * t).exp();
+                }
+                surface + (initial - surface) * sum
+            }
             Reference::AnnulusSteady {
                 inner_radius: ri,
                 outer_radius: ro,
@@ -282,6 +319,49 @@ fn duhamel(amp: f64, r: f64, mu: f64, t: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sphere series against an independent radial finite-difference solve of
+    /// u = rθ (u_t = α u_rr, u(0) = 0, u(R) = Rθ_s): 400 intervals, explicit steps of
+    /// 0.25 h²/α, at t = 0.02 and 0.1 R²/α. The FD error is O(h²) ≈ 1e-4 of the jump
+    /// θ_0 − θ_s here, so 2e-3 of the jump bounds the comparison.
+    #[test]
+    fn sphere_series_matches_a_radial_solve() {
+        let (rs, a, ts, t0) = (0.1, 400.0 / (8920.0 * 385.0), 300.0, 1000.0);
+        let sphere = Reference::SphereFixedSurface {
+            radius: rs,
+            diffusivity: a,
+            surface: ts,
+            initial: t0,
+        };
+        let n = 400;
+        let h = rs / n as f64;
+        let dt = 0.25 * h * h / a;
+        let mut u: Vec<f64> = (0..=n).map(|i| i as f64 * h * t0).collect();
+        u[n] = rs * ts;
+        let mut t = 0.0;
+        for t_check in [0.02 * rs * rs / a, 0.1 * rs * rs / a] {
+            while t < t_check - 1e-12 {
+                let step = dt.min(t_check - t);
+                let old = u.clone();
+                for i in 1..n {
+                    u[i] = old[i] + a * step / (h * h) * (old[i - 1] - 2.0 * old[i] + old[i + 1]);
+                }
+                t += step;
+            }
+            for i in [1, n / 4, n / 2, 3 * n / 4] {
+                let r = i as f64 * h;
+                let fd = u[i] / r;
+                let series = sphere.eval(r, 0.0, t);
+                assert!(
+                    (fd - series).abs() < 2e-3 * (t0 - ts),
+                    "t = {t}, r = {r}: FD {fd}, series {series}"
+                );
+            }
+        }
+        // the centre is finite and the surface is held
+        assert!(sphere.eval(0.0, 0.0, 1.0).is_finite());
+        assert!((sphere.eval(rs, 0.0, 1.0) - ts).abs() < 1e-9 * t0);
+    }
 
     /// Seed 000's printed midpoint values at t = 8 s (±0.005 °C: the paper prints 2 decimals).
     #[test]
