@@ -129,7 +129,7 @@ impl FemModel {
 
 /// Number of equal steps no longer than `dt` that cover `span`, s.
 pub fn steps_for(span: f64, dt: f64) -> u64 {
-    ((span / dt) * (1.0 - 1e-12)).ceil().max(1.0) as u64
+    crate::solve::explicit::steps_between(0.0, span, dt).max(1)
 }
 
 fn keyed(case: &Case, e: Error) -> Error {

@@ -109,7 +109,7 @@ pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Re
 
 /// Steps from `t` to `to` when no step may exceed `dt` (a relative 1e-12 slack keeps
 /// round-off from adding a step).
-fn steps_between(t: f64, to: f64, dt: f64) -> u64 {
+pub fn steps_between(t: f64, to: f64, dt: f64) -> u64 {
     ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64
 }
 

@@ -41,7 +41,7 @@
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::operator::Conductance;
-use crate::solve::explicit::RunStats;
+use crate::solve::explicit::{steps_between, RunStats};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
@@ -854,7 +854,7 @@ impl<'a> Implicit<'a> {
             &mut self.f_now,
         );
         for (k, &to) in outputs.iter().enumerate() {
-            let n = ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64;
+            let n = steps_between(t, to, dt);
             let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
             for s in 0..n {
                 let t1 = if s + 1 == n {
