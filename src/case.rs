@@ -18,6 +18,7 @@ use crate::math::Point;
 use crate::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
 use crate::reference::ReferenceTable;
 use crate::solve::explicit::Integrator;
+use crate::symmetry::Symmetry;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -42,6 +43,9 @@ pub struct CaseFile {
     pub title: String,
     /// Spatial dimension, 1..=3.
     pub dimension: usize,
+    /// `planar` (default), `axisymmetric` (x = r, y = z) or `spherical` (x = r); seed 001.
+    #[serde(default)]
+    pub symmetry: Symmetry,
     /// The built-in box domain (or give `mesh`).
     #[serde(default)]
     pub domain: Option<DomainSpec>,
@@ -906,6 +910,29 @@ impl CaseFile {
                 ))
             }
         };
+        if !self.symmetry.allows_dimension(dim) {
+            return Err(err(
+                "symmetry",
+                format!(
+                    "{} symmetry needs dimension {}, got {dim}",
+                    self.symmetry.name(),
+                    if self.symmetry == Symmetry::Spherical {
+                        "1"
+                    } else {
+                        "1 or 2"
+                    }
+                ),
+            ));
+        }
+        if self.symmetry.is_symmetric() && (thickness.is_some() || area.is_some()) {
+            return Err(err(
+                &format!("{section}.{}", if dim == 1 { "area" } else { "thickness" }),
+                format!(
+                    "does not apply to a {} body: its nodes are rings or shells of measure 2πr or 4πr² per planar cell",
+                    self.symmetry.name()
+                ),
+            ));
+        }
         let tau = match dim {
             1 => {
                 if thickness.is_some() {
@@ -1207,6 +1234,7 @@ impl CaseFile {
                 initial,
                 linear_consistency: self.kernel.linear_consistency,
                 crack_correction: self.kernel.crack_correction,
+                symmetry: self.symmetry,
             },
             integrator: self.time.integrator,
             dt: self.time.dt,

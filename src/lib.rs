@@ -33,5 +33,6 @@ pub mod run;
 pub mod solve;
 pub mod spatial;
 pub mod sweep;
+pub mod symmetry;
 
 pub use error::{Error, Result};

@@ -14,6 +14,7 @@ use crate::material::{BondRule, Material};
 use crate::math::Point;
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
+use crate::symmetry::Symmetry;
 
 /// Initial temperature field.
 #[derive(Debug, Clone)]
@@ -107,6 +108,8 @@ pub struct ModelSpec {
     /// Restore, at nodes whose bonds a pre-crack cuts, the second moment of their horizon
     /// ([`crate::crack::restore_moment`]).
     pub crack_correction: bool,
+    /// Planar, axisymmetric or spherical body (seed 001, formulation §7).
+    pub symmetry: Symmetry,
 }
 
 /// Cutting facets of the cracks (formulation §5).
@@ -274,6 +277,8 @@ impl Model {
             }
             Geometry::Mesh(g) => g.generate(&layered, band)?,
         };
+        let mut cloud = cloud;
+        cloud.apply_symmetry(spec.symmetry)?;
         let mat = |i: usize| spec.materials[cloud.material[i] as usize];
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();

@@ -2,7 +2,8 @@
 //!
 //! `V_i ρc_i dθ_i/dt = Σ_j K_ij (θ_j − θ_i)` with `K_ij = V_i V_j (w_ij + w_ji)` and the
 //! directed half-conductances `w_ij = ½ c_i(|ξ_ij|) β_ij` (seed 004 eqs 19–24; w_ij = 0 when
-//! j ∉ H_i). K is symmetric, so the bond sum conserves energy exactly.
+//! j ∉ H_i). K is symmetric, so the bond sum conserves energy exactly. Axisymmetric and
+//! spherical clouds multiply each pair by the factor of [`crate::symmetry`] (seed 001 eqs 10, 21).
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
@@ -34,6 +35,7 @@ pub fn directed_weights(
 ) -> Vec<f64> {
     let mut w = vec![0.0; horizons.n_bonds()];
     let units = unit_normalisations(cloud, kernel);
+    let sym = cloud.symmetry;
     horizons
         .rows_mut(&mut w)
         .into_par_iter()
@@ -46,7 +48,14 @@ pub fn directed_weights(
                 let r = (cloud.pos[j] - cloud.pos[i]).norm();
                 let k = rule.combine(conductivity[i], conductivity[j]);
                 let c = kernel.micro(unit * k, r, horizons.eval_at[b], delta);
-                *s = 0.5 * cloud.volume[i] * cloud.volume[j] * c * horizons.beta[b];
+                // planar measures times the ring/shell pair factor (formulation §7)
+                let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
+                let shape = if sym.is_symmetric() {
+                    sym.pair_factor(ri, rj) / (sym.volume_factor(ri) * sym.volume_factor(rj))
+                } else {
+                    1.0
+                };
+                *s = 0.5 * cloud.volume[i] * cloud.volume[j] * shape * c * horizons.beta[b];
             }
         });
     w

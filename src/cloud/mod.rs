@@ -10,6 +10,7 @@ pub mod order;
 
 use crate::error::{Error, Result};
 use crate::math::{NodeId, Point, Vector};
+use crate::symmetry::Symmetry;
 use facets::FacetSet;
 
 /// Faces of an axis-aligned box, in the order x_min, x_max, y_min, y_max, z_min, z_max.
@@ -85,7 +86,8 @@ pub struct Cloud {
     pub tau: f64,
     /// Node positions, m.
     pub pos: Vec<Point>,
-    /// True node volumes V_i (length × A, area × h, volume), m³.
+    /// True node volumes V_i (length × A, area × h, volume; rings and shells when
+    /// [`Cloud::symmetry`] is not planar), m³.
     pub volume: Vec<f64>,
     /// Node spacing Δ_i, m.
     pub spacing: Vec<f64>,
@@ -107,6 +109,8 @@ pub struct Cloud {
     pub max: Point,
     /// Whether nodes sit on the boundary with partial volumes (seed 003 §3).
     pub boundary_placement: bool,
+    /// Planar, or rings/shells about the axis x = 0 (seed 001, formulation §7).
+    pub symmetry: Symmetry,
 }
 
 impl Cloud {
@@ -154,6 +158,34 @@ impl Cloud {
     pub fn exposed_area(&self, i: usize) -> f64 {
         let f = if self.boundary_placement { 2.0 } else { 1.0 };
         f * self.volume[i] / self.spacing[i]
+    }
+
+    /// Turns planar node measures into ring or shell volumes (× 2πr or 4πr², r = x). Every
+    /// node, fictitious ones included, must lie at r > 0: the axis or centre takes no layer.
+    pub fn apply_symmetry(&mut self, symmetry: Symmetry) -> Result<()> {
+        self.symmetry = symmetry;
+        if !symmetry.is_symmetric() {
+            return Ok(());
+        }
+        if let Some(i) = (0..self.len()).find(|&i| self.pos[i].x <= 0.0) {
+            let what = if i < self.n_body {
+                "a body node"
+            } else {
+                "a fictitious node"
+            };
+            return Err(Error::model(
+                "symmetry",
+                format!(
+                "{} model: {what} lies at r = x = {:.6e} ≤ 0; the body must lie at x ≥ 0 and the face at the axis (x = 0) takes no fictitious layer (leave it free: no bonds cross the axis)",
+                symmetry.name(),
+                self.pos[i].x
+            ),
+            ));
+        }
+        for (v, p) in self.volume.iter_mut().zip(&self.pos) {
+            *v *= symmetry.volume_factor(p.x);
+        }
+        Ok(())
     }
 
     /// Total body volume, m³.
@@ -224,12 +256,24 @@ impl Cloud {
             Sides::Box => self
                 .face_layer(s, 1.0)
                 .into_iter()
-                .map(|i| (i, self.exposed_area(i)))
+                .map(|i| {
+                    // a face of constant r: the ring or shell area there, not at the node
+                    let scale = if s / 2 == 0 {
+                        self.symmetry.volume_factor(self.face_plane(s))
+                            / self.symmetry.volume_factor(self.pos[i].x)
+                    } else {
+                        1.0
+                    };
+                    (i, self.exposed_area(i) * scale)
+                })
                 .collect(),
             Sides::Mesh(m) => {
                 let mut area: std::collections::BTreeMap<usize, f64> = Default::default();
                 for f in &m.sets[s].facets {
-                    *area.entry(f.cell as usize).or_default() += f.area;
+                    let n = f.corners.len() as f64;
+                    let r = f.corners.iter().map(|c| c.x).sum::<f64>() / n;
+                    *area.entry(f.cell as usize).or_default() +=
+                        f.area * self.symmetry.volume_factor(r);
                 }
                 area.into_iter().collect()
             }
