@@ -50,6 +50,15 @@ pub enum FaceBc {
         /// q(x, y, z, t) into the body, W/m².
         value: Expr,
     },
+    /// Convection through a mirrored fictitious layer (seed 001 §3.1c): the ghost at distance d
+    /// from its mirror node satisfies k(θ_f − θ_m)/d = h(T∞ − (θ_f + θ_m)/2), i.e.
+    /// θ_f = ((1 − β/2) θ_m + β T∞)/(1 + β/2) with β = h d/k.
+    LayerConvection {
+        /// Film coefficient h, W/(m²·K).
+        h: f64,
+        /// T∞(t), °C.
+        ambient: Expr,
+    },
     /// Convection to an ambient temperature (seed 001): s = h A (T∞ − θ)/V on surface nodes.
     Convection {
         /// Film coefficient h, W/(m²·K).
@@ -64,7 +73,10 @@ impl FaceBc {
     pub fn needs_layer(&self) -> bool {
         matches!(
             self,
-            FaceBc::LayerTemperature { .. } | FaceBc::LayerInsulated | FaceBc::LayerFlux { .. }
+            FaceBc::LayerTemperature { .. }
+                | FaceBc::LayerInsulated
+                | FaceBc::LayerFlux { .. }
+                | FaceBc::LayerConvection { .. }
         )
     }
 }
@@ -270,6 +282,13 @@ impl Boundary {
                     ..
                 } => (-1.0, 2.0),
                 FaceBc::LayerFlux { .. } => (1.0, 1.0 / k),
+                FaceBc::LayerConvection { h, .. } => {
+                    let beta = h * r.distance / k;
+                    (
+                        (1.0 - 0.5 * beta) / (1.0 + 0.5 * beta),
+                        beta / (1.0 + 0.5 * beta),
+                    )
+                }
                 _ => (1.0, 0.0),
             };
             if coef != 0.0 && s != 0.0 {
@@ -386,6 +405,7 @@ impl Boundary {
                 let val = match &self.faces[fc] {
                     FaceBc::LayerTemperature { value, .. } => value.eval(at.x, at.y, at.z, t),
                     FaceBc::LayerFlux { value } => value.eval(at.x, at.y, at.z, t) * d,
+                    FaceBc::LayerConvection { ambient, .. } => ambient.eval(at.x, at.y, at.z, t),
                     _ => 0.0,
                 };
                 v += coef * val;

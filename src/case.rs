@@ -249,7 +249,7 @@ pub struct BoundarySpec {
     #[serde(rename = "type")]
     pub kind: BoundaryKind,
     /// temperature: nodal (default), mirror, naive; insulated: mirror (default) or free;
-    /// flux: mirror (default) or relation.
+    /// flux: mirror (default) or relation; convection: surface (default) or mirror.
     #[serde(default)]
     pub method: Option<String>,
     /// Temperature (°C) or flux into the body (W/m²): number or expression.
@@ -1163,9 +1163,11 @@ impl CaseFile {
                         .ambient
                         .as_ref()
                         .ok_or_else(|| err(&key("ambient"), "missing".into()))?;
-                    FaceBc::Convection {
-                        h,
-                        ambient: expr(amb, path, &key("ambient"))?,
+                    let ambient = expr(amb, path, &key("ambient"))?;
+                    match method {
+                        None | Some("surface") => FaceBc::Convection { h, ambient },
+                        Some("mirror") => FaceBc::LayerConvection { h, ambient },
+                        _ => return Err(bad_method("surface, mirror")),
                     }
                 }
             };

@@ -150,7 +150,7 @@ impl Conditions {
                     scale: 1.0,
                     points: set.iter().flat_map(|&f| facet_points(mesh, f)).collect(),
                 }),
-                FaceBc::Convection { h, ambient } => {
+                FaceBc::Convection { h, ambient } | FaceBc::LayerConvection { h, ambient } => {
                     c.convective |= !set.is_empty();
                     let points: Vec<QPoint> =
                         set.iter().flat_map(|&f| facet_points(mesh, f)).collect();
