@@ -111,6 +111,8 @@ struct RelationNodal {
 #[derive(Debug, Clone)]
 struct Ghost {
     node: usize,
+    /// Conductivity the flux terms' 1/k was taken with, W/(m·K).
+    k: f64,
     sigma: f64,
     stencil: Vec<(NodeId, f64)>,
     terms: Vec<(usize, f64, f64, Point)>,
@@ -360,6 +362,7 @@ impl Boundary {
             };
             self.ghosts.push(Ghost {
                 node,
+                k: conductivity[node],
                 sigma,
                 stencil,
                 terms,
@@ -369,6 +372,18 @@ impl Boundary {
 
     /// Sets every constrained body node and every fictitious node at time `t`.
     pub fn apply(&self, cloud: &Cloud, theta: &mut [f64], t: f64) {
+        self.apply_with(cloud, theta, t, None);
+    }
+
+    /// [`Boundary::apply`] with the body's conductivity as it is now (phase change,
+    /// formulation §6): a mirrored flux layer then takes q/k with k at its mirror point, W/(m·K).
+    pub fn apply_with(
+        &self,
+        cloud: &Cloud,
+        theta: &mut [f64],
+        t: f64,
+        conductivity: Option<&[f64]>,
+    ) {
         for n in &self.nodal {
             if n.value.is_uniform() {
                 let v = n.value.eval(0.0, 0.0, 0.0, t);
@@ -404,7 +419,21 @@ impl Boundary {
             for &(fc, coef, d, at) in &g.terms {
                 let val = match &self.faces[fc] {
                     FaceBc::LayerTemperature { value, .. } => value.eval(at.x, at.y, at.z, t),
-                    FaceBc::LayerFlux { value } => value.eval(at.x, at.y, at.z, t) * d,
+                    FaceBc::LayerFlux { value } => {
+                        let scale = match conductivity {
+                            Some(k) => {
+                                let now: f64 =
+                                    g.stencil.iter().map(|&(j, w)| w * k[j as usize]).sum();
+                                if now > 0.0 {
+                                    g.k / now
+                                } else {
+                                    1.0
+                                }
+                            }
+                            None => 1.0,
+                        };
+                        value.eval(at.x, at.y, at.z, t) * d * scale
+                    }
                     FaceBc::LayerConvection { ambient, .. } => ambient.eval(at.x, at.y, at.z, t),
                     _ => 0.0,
                 };

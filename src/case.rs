@@ -308,16 +308,12 @@ pub struct TimeSpec {
     /// Time step, s (default: 0.95 of the stable bound).
     #[serde(default)]
     pub dt: Option<f64>,
-    /// euler or rk4 (default rk4).
-    #[serde(default = "default_integrator")]
-    pub integrator: Integrator,
+    /// euler, rk4 or an implicit scheme (default rk4; euler with phase change, seed 001).
+    #[serde(default)]
+    pub integrator: Option<Integrator>,
     /// Output times, s (default: the end time).
     #[serde(default)]
     pub outputs: Vec<f64>,
-}
-
-fn default_integrator() -> Integrator {
-    Integrator::Rk4
 }
 
 /// `[reference]` as written: one classical solution and where to compare.
@@ -975,17 +971,8 @@ impl CaseFile {
         let names: Vec<&String> = self.material.keys().collect();
         let mut materials = Vec::new();
         for (name, m) in &self.material {
-            positive(
-                path,
-                &format!("material.{name}.conductivity"),
-                m.conductivity,
-            )?;
-            positive(path, &format!("material.{name}.density"), m.density)?;
-            positive(
-                path,
-                &format!("material.{name}.specific_heat"),
-                m.specific_heat,
-            )?;
+            m.check()
+                .map_err(|(key, message)| err(&format!("material.{name}.{key}"), message))?;
             materials.push(*m);
         }
         if self.region.is_empty() {
@@ -1222,6 +1209,14 @@ impl CaseFile {
             Some(r) => Some(reference(r, path, dim, &outputs)?),
             None => None,
         };
+        let integrator =
+            self.time
+                .integrator
+                .unwrap_or(if materials.iter().any(|m| m.phase_change.is_some()) {
+                    Integrator::Euler
+                } else {
+                    Integrator::Rk4
+                });
         Ok(Case {
             path: path.to_path_buf(),
             title: self.title,
@@ -1238,7 +1233,7 @@ impl CaseFile {
                 crack_correction: self.kernel.crack_correction,
                 symmetry: self.symmetry,
             },
-            integrator: self.time.integrator,
+            integrator,
             dt: self.time.dt,
             end,
             outputs,

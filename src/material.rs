@@ -1,20 +1,226 @@
-//! Materials and the bond-conductivity rule at interfaces (formulation §2.4).
+//! Materials, their enthalpy–temperature relation (formulation §6, seed 001 eqs 1–3) and the
+//! bond-conductivity rule at interfaces (formulation §2.4).
 
 use serde::{Deserialize, Serialize};
 
-/// A linear conducting material.
+/// A conducting material; with `phase_change` its properties are those of the melted phase.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// Thermal conductivity k, W/(m·K).
+    /// Thermal conductivity k (λ_m of the melted phase), W/(m·K).
     pub conductivity: f64,
-    /// Density ρ, kg/m³.
+    /// Density ρ (ρ_m), kg/m³.
     pub density: f64,
-    /// Specific heat c, J/(kg·K).
+    /// Specific heat c (C_m), J/(kg·K).
     pub specific_heat: f64,
+    /// Freezing/melting at one temperature (seed 001 §2.1); None for a linear material.
+    #[serde(default)]
+    pub phase_change: Option<PhaseChange>,
+}
+
+/// `[material.<name>.phase_change]`: the frozen phase and the latent heat (seed 001 eqs 1–3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseChange {
+    /// Phase-change temperature T_f, °C (or K).
+    pub temperature: f64,
+    /// Specific latent heat L, J/kg.
+    pub latent_heat: f64,
+    /// Fraction Π of the volume that changes phase (default 1).
+    #[serde(default = "one")]
+    pub fraction: f64,
+    /// Conductivity λ_f of the frozen phase, W/(m·K).
+    pub frozen_conductivity: f64,
+    /// Density ρ_f of the frozen phase (default: the melted density), kg/m³.
+    #[serde(default)]
+    pub frozen_density: Option<f64>,
+    /// Specific heat C_f of the frozen phase, J/(kg·K).
+    pub frozen_specific_heat: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The enthalpy per unit volume H(θ) ↔ θ(H) relation of one material (formulation §6), with
+/// H = ρ_f C_f θ below T_f (H = ρcθ for a linear material). Precomputed for the time loop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Enthalpy {
+    /// ρ_f C_f (ρc for a linear material), J/(m³·K).
+    frozen_capacity: f64,
+    /// ρ_m C_m, J/(m³·K).
+    melted_capacity: f64,
+    /// T_f (+∞ for a linear material: always "frozen").
+    t_f: f64,
+    /// H at the start of the plateau, ρ_f C_f T_f, J/m³.
+    h_solid: f64,
+    /// H at the end of the plateau, ρ_f C_f T_f + ρ_f Π L, J/m³.
+    h_liquid: f64,
+    /// λ_f, W/(m·K).
+    k_frozen: f64,
+    /// λ_m, W/(m·K).
+    k_melted: f64,
+}
+
+impl Enthalpy {
+    /// Temperature at enthalpy `h` (seed 001 eq. 3), °C.
+    #[inline]
+    pub fn temperature(&self, h: f64) -> f64 {
+        if h < self.h_solid {
+            h / self.frozen_capacity
+        } else if h <= self.h_liquid {
+            self.t_f
+        } else {
+            self.t_f + (h - self.h_liquid) / self.melted_capacity
+        }
+    }
+
+    /// Enthalpy at temperature `t`, J/m³; at T_f exactly, the frozen end of the plateau.
+    #[inline]
+    pub fn enthalpy(&self, t: f64) -> f64 {
+        if t <= self.t_f {
+            self.frozen_capacity * t
+        } else {
+            self.h_liquid + self.melted_capacity * (t - self.t_f)
+        }
+    }
+
+    /// Conductivity at enthalpy `h` (seed 001 eq. 1: the mean of λ_f and λ_m on the plateau),
+    /// W/(m·K).
+    #[inline]
+    pub fn conductivity(&self, h: f64) -> f64 {
+        if h < self.h_solid {
+            self.k_frozen
+        } else if h <= self.h_liquid {
+            0.5 * (self.k_frozen + self.k_melted)
+        } else {
+            self.k_melted
+        }
+    }
+
+    /// Melted fraction at enthalpy `h`: 0 frozen, 1 melted, linear across the plateau.
+    pub fn melted_fraction(&self, h: f64) -> f64 {
+        if self.h_liquid > self.h_solid {
+            ((h - self.h_solid) / (self.h_liquid - self.h_solid)).clamp(0.0, 1.0)
+        } else if h < self.h_solid {
+            0.0
+        } else {
+            1.0
+        }
+    }
+
+    /// Largest conductivity of any phase, W/(m·K).
+    pub fn max_conductivity(&self) -> f64 {
+        self.k_frozen.max(self.k_melted)
+    }
+
+    /// Smallest volumetric heat capacity of any phase, J/(m³·K).
+    pub fn min_capacity(&self) -> f64 {
+        self.frozen_capacity.min(self.melted_capacity)
+    }
 }
 
 impl Material {
+    /// Checks every property: `Err((key, message))` names the offending key, e.g.
+    /// `phase_change.latent_heat`.
+    pub fn check(&self) -> Result<(), (String, String)> {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let mut checks = vec![
+            (
+                "conductivity",
+                self.conductivity,
+                positive(self.conductivity),
+                "a positive number",
+            ),
+            (
+                "density",
+                self.density,
+                positive(self.density),
+                "a positive number",
+            ),
+            (
+                "specific_heat",
+                self.specific_heat,
+                positive(self.specific_heat),
+                "a positive number",
+            ),
+        ];
+        if let Some(p) = self.phase_change {
+            let rho = p.frozen_density.unwrap_or(self.density);
+            checks.extend([
+                (
+                    "phase_change.temperature",
+                    p.temperature,
+                    p.temperature.is_finite(),
+                    "finite",
+                ),
+                (
+                    "phase_change.latent_heat",
+                    p.latent_heat,
+                    p.latent_heat.is_finite() && p.latent_heat >= 0.0,
+                    "finite and ≥ 0",
+                ),
+                (
+                    "phase_change.fraction",
+                    p.fraction,
+                    (0.0..=1.0).contains(&p.fraction),
+                    "in [0, 1]",
+                ),
+                (
+                    "phase_change.frozen_conductivity",
+                    p.frozen_conductivity,
+                    positive(p.frozen_conductivity),
+                    "a positive number",
+                ),
+                (
+                    "phase_change.frozen_density",
+                    rho,
+                    positive(rho),
+                    "a positive number",
+                ),
+                (
+                    "phase_change.frozen_specific_heat",
+                    p.frozen_specific_heat,
+                    positive(p.frozen_specific_heat),
+                    "a positive number",
+                ),
+            ]);
+        }
+        match checks.into_iter().find(|c| !c.2) {
+            Some((key, v, _, what)) => Err((key.to_string(), format!("must be {what}, got {v}"))),
+            None => Ok(()),
+        }
+    }
+
+    /// The material's enthalpy relation (formulation §6).
+    pub fn enthalpy(&self) -> Enthalpy {
+        match self.phase_change {
+            None => Enthalpy {
+                frozen_capacity: self.capacity(),
+                melted_capacity: self.capacity(),
+                t_f: f64::INFINITY,
+                h_solid: f64::INFINITY,
+                h_liquid: f64::INFINITY,
+                k_frozen: self.conductivity,
+                k_melted: self.conductivity,
+            },
+            Some(p) => {
+                let rho_f = p.frozen_density.unwrap_or(self.density);
+                let frozen_capacity = rho_f * p.frozen_specific_heat;
+                let h_solid = frozen_capacity * p.temperature;
+                Enthalpy {
+                    frozen_capacity,
+                    melted_capacity: self.capacity(),
+                    t_f: p.temperature,
+                    h_solid,
+                    h_liquid: h_solid + rho_f * p.fraction * p.latent_heat,
+                    k_frozen: p.frozen_conductivity,
+                    k_melted: self.conductivity,
+                }
+            }
+        }
+    }
+
     /// Volumetric heat capacity ρc, J/(m³·K).
     pub fn capacity(&self) -> f64 {
         self.density * self.specific_heat
@@ -48,6 +254,54 @@ impl BondRule {
             BondRule::Harmonic => 2.0 * a * b / (a + b),
             BondRule::Lower => a.min(b),
             BondRule::Arithmetic => 0.5 * (a + b),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn water() -> Material {
+        Material {
+            conductivity: 0.6,
+            density: 1000.0,
+            specific_heat: 4182.0,
+            phase_change: Some(PhaseChange {
+                temperature: 273.15,
+                latent_heat: 333e3,
+                fraction: 1.0,
+                frozen_conductivity: 2.14,
+                frozen_density: None,
+                frozen_specific_heat: 2060.0,
+            }),
+        }
+    }
+
+    #[test]
+    fn enthalpy_and_temperature_are_inverse_off_the_plateau() {
+        let e = water().enthalpy();
+        for t in [200.0, 273.0, 273.2, 300.0, 373.15] {
+            assert!((e.temperature(e.enthalpy(t)) - t).abs() < 1e-9 * t, "{t}");
+        }
+        // seed 001 eq 3: the plateau is ρ_f Π L wide and sits at T_f
+        let hs = 1000.0 * 2060.0 * 273.15;
+        assert_eq!(e.temperature(hs + 0.5 * 1000.0 * 333e3), 273.15);
+        assert!((e.temperature(hs + 1000.0 * 333e3 + 4182.0e3) - 274.15).abs() < 1e-9);
+        assert_eq!(e.conductivity(hs + 1.0), 0.5 * (2.14 + 0.6));
+        assert_eq!(e.conductivity(hs - 1.0), 2.14);
+    }
+
+    #[test]
+    fn a_linear_material_is_h_equals_rho_c_theta() {
+        let m = Material {
+            phase_change: None,
+            ..water()
+        };
+        let e = m.enthalpy();
+        for t in [-50.0, 0.0, 20.0, 1e4] {
+            assert_eq!(e.enthalpy(t), m.capacity() * t);
+            assert_eq!(e.conductivity(e.enthalpy(t)), 0.6);
         }
     }
 }

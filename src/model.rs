@@ -10,7 +10,7 @@ use crate::crack::{
 use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::kernel::{Kernel, PartialVolume};
-use crate::material::{BondRule, Material};
+use crate::material::{BondRule, Enthalpy, Material};
 use crate::math::Point;
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
@@ -171,12 +171,18 @@ pub struct Model {
     pub horizons: Horizons,
     /// Symmetric pair conductance, W/K.
     pub conductance: Conductance,
-    /// Conductivity per node, W/(m·K).
+    /// Conductivity per node (with phase change: the largest of its phases), W/(m·K).
     pub conductivity: Vec<f64>,
-    /// Volumetric heat capacity ρc per node, J/(m³·K).
+    /// Volumetric heat capacity ρc per node (with phase change: the smallest), J/(m³·K).
     pub capacity: Vec<f64>,
     /// 1 / (V_i ρc_i) per body node, K/J.
     pub inv_heat_capacity: Vec<f64>,
+    /// With phase change (formulation §6): each material's enthalpy relation, and then
+    /// `conductance` holds K for unit conductivity, K_ij(t) = λ̄_ij(t)·K_ij with λ̄ from
+    /// `bond_rule`; the boundary's loads are then in W/m³. None for a linear model.
+    pub enthalpy: Option<Vec<Enthalpy>>,
+    /// Interface rule for the bond conductivity λ̄_ij (formulation §2.4).
+    pub bond_rule: BondRule,
     /// Boundary conditions and loads.
     pub boundary: Boundary,
     /// Initial temperature of every node, °C.
@@ -245,18 +251,26 @@ impl Model {
     /// Builds cloud, bonds, conductance and boundary from a spec.
     pub fn build(spec: &ModelSpec) -> Result<Model> {
         for (m, mat) in spec.materials.iter().enumerate() {
-            for (name, v) in [
-                ("conductivity", mat.conductivity),
-                ("density", mat.density),
-                ("specific_heat", mat.specific_heat),
-            ] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(Error::model(
-                        format!("material[{m}].{name}"),
-                        format!("must be a positive number, got {v}"),
-                    ));
-                }
-            }
+            mat.check()
+                .map_err(|(key, message)| Error::model(format!("material[{m}].{key}"), message))?;
+        }
+        let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
+        if phase
+            && spec
+                .faces
+                .iter()
+                .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
+        {
+            return Err(Error::model(
+                "boundary",
+                "a flux condition with method = \"relation\" does not apply with phase change; use method = \"mirror\"",
+            ));
+        }
+        if phase && spec.linear_consistency {
+            return Err(Error::model(
+                "kernel.linear_consistency",
+                "does not apply with phase change: the conductances change with temperature",
+            ));
         }
         let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
         let band = match spec.kernel.partial_volume {
@@ -283,11 +297,17 @@ impl Model {
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
         let horizons = Horizons::build(&cloud, &spec.kernel);
+        // with phase change, K for unit conductivity; λ̄_ij(t) scales it as the state evolves
+        let bond_conductivity = if phase {
+            vec![1.0; cloud.len()]
+        } else {
+            conductivity.clone()
+        };
         let mut weights = directed_weights(
             &cloud,
             &horizons,
             &spec.kernel,
-            &conductivity,
+            &bond_conductivity,
             spec.bond_rule,
         );
         let cutters = cutters(&cloud, &spec.cracks);
@@ -343,11 +363,13 @@ impl Model {
         } else {
             Vec::new()
         };
+        // with phase change the loads are enthalpy rates (W/m³): unit capacity
+        let unit = vec![1.0; if phase { cloud.len() } else { 0 }];
         let boundary = Boundary::build(BoundaryInput {
             cloud: &cloud,
             faces: spec.faces.clone(),
             conductivity: &conductivity,
-            capacity: &capacity,
+            capacity: if phase { &unit } else { &capacity },
             micro: if needs_micro {
                 Some((&horizons, &micro))
             } else {
@@ -355,6 +377,18 @@ impl Model {
             },
             source: spec.source.clone(),
         });
+        let enthalpy: Option<Vec<Enthalpy>> =
+            phase.then(|| spec.materials.iter().map(Material::enthalpy).collect());
+        let (conductivity, capacity) = match &enthalpy {
+            Some(e) => {
+                let at = |i: usize| e[cloud.material[i] as usize];
+                (
+                    (0..cloud.len()).map(|i| at(i).max_conductivity()).collect(),
+                    (0..cloud.len()).map(|i| at(i).min_capacity()).collect(),
+                )
+            }
+            None => (conductivity, capacity),
+        };
         let inv_heat_capacity = (0..cloud.n_body)
             .map(|i| 1.0 / (cloud.volume[i] * capacity[i]))
             .collect();
@@ -367,6 +401,8 @@ impl Model {
             conductivity,
             capacity,
             inv_heat_capacity,
+            enthalpy,
+            bond_rule: spec.bond_rule,
             boundary,
             theta0,
             correction,
@@ -390,19 +426,42 @@ impl Model {
         damage(&self.cloud, &self.horizons, &mu)
     }
 
-    /// Total thermal energy of the body, Σ V_i ρc_i θ_i, J (relative to 0 °C).
+    /// Total thermal energy of the body, Σ V_i ρc_i θ_i, J (relative to 0 °C); with phase
+    /// change Σ V_i H(θ_i), a node at T_f counted frozen (the stepper's own
+    /// [`crate::solve::enthalpy::Enthalpic::energy`] knows where on the plateau it is).
     pub fn energy(&self, theta: &[f64]) -> f64 {
+        if let Some(e) = &self.enthalpy {
+            return (0..self.cloud.n_body)
+                .map(|i| {
+                    self.cloud.volume[i] * e[self.cloud.material[i] as usize].enthalpy(theta[i])
+                })
+                .sum();
+        }
         (0..self.cloud.n_body)
             .map(|i| self.cloud.volume[i] * self.capacity[i] * theta[i])
             .sum()
     }
 
     /// Gershgorin bound on the largest eigenvalue of the free-node system, 1/s (formulation §4).
+    ///
+    /// With phase change K holds unit conductivities and the loads are per unit capacity, so
+    /// the bound takes the largest conductivity and the smallest capacity of any phase.
     pub fn lambda_max(&self) -> f64 {
         let loads = self.boundary.load_diagonal(self.cloud.n_body);
+        let (k_max, load_scale) = match self.enthalpy {
+            Some(_) => (self.conductivity.iter().copied().fold(0.0, f64::max), true),
+            None => (1.0, false),
+        };
         (0..self.cloud.n_body)
             .filter(|&i| !self.boundary.driven[i])
-            .map(|i| 2.0 * self.conductance.diag[i] * self.inv_heat_capacity[i] + loads[i])
+            .map(|i| {
+                let load = if load_scale {
+                    loads[i] / self.capacity[i]
+                } else {
+                    loads[i]
+                };
+                2.0 * k_max * self.conductance.diag[i] * self.inv_heat_capacity[i] + load
+            })
             .fold(0.0, f64::max)
     }
 }

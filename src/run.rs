@@ -10,6 +10,7 @@ use crate::output::read_field;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
+use crate::solve::enthalpy::Enthalpic;
 use crate::solve::explicit::{choose_dt, count_steps, Explicit, Integrator};
 use crate::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
@@ -47,6 +48,11 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
         Integrator::Euler | Integrator::Rk4 => None,
     };
+    // phase change: the enthalpy form of forward Euler (seed 001), refusing other integrators
+    let mut enthalpic = match model.enthalpy {
+        Some(_) => Some(Enthalpic::new(&model, case.integrator).map_err(in_case)?),
+        None => None,
+    };
     // the implicit system (elimination, symbolic factorisation) is part of the set-up
     let mut implicit = match scheme {
         Some(s) => Some(Implicit::new(&model, s, Options::default()).map_err(in_case)?),
@@ -73,54 +79,65 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
     let started = Instant::now();
     let reference = resolve_reference(case, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
-    let on_output = |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance| {
-        energy.push(model.energy(th));
-        let path = field_path(out, k + 1);
-        let flux = conductance.flux(&model.cloud, th);
-        let damage = model.damage_at(t);
-        let classical = match &reference {
-            Some(r) => {
-                let started = Instant::now();
-                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                let tips = tips_at(&cutters, t);
-                comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
-                reference_seconds += started.elapsed().as_secs_f64();
-                Some(classical)
-            }
-            None => None,
+    let mut on_output =
+        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
+            energy.push(e);
+            let path = field_path(out, k + 1);
+            let flux = conductance.flux(&model.cloud, th);
+            let damage = model.damage_at(t);
+            let classical = match &reference {
+                Some(r) => {
+                    let started = Instant::now();
+                    let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                    let tips = tips_at(&cutters, t);
+                    comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
+                    reference_seconds += started.elapsed().as_secs_f64();
+                    Some(classical)
+                }
+                None => None,
+            };
+            let f = Fields {
+                theta: th,
+                damage: &damage,
+                flux: &flux,
+                reference: classical.as_deref(),
+            };
+            write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+            write_atomic(
+                &vtu_path(out, k + 1),
+                field_vtu(&model.cloud, &f).as_bytes(),
+            )?;
+            fields.push(
+                path.file_name()
+                    .expect("file")
+                    .to_string_lossy()
+                    .into_owned(),
+            );
+            Ok(())
         };
-        let f = Fields {
-            theta: th,
-            damage: &damage,
-            flux: &flux,
-            reference: classical.as_deref(),
-        };
-        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-        write_atomic(
-            &vtu_path(out, k + 1),
-            field_vtu(&model.cloud, &f).as_bytes(),
-        )?;
-        fields.push(
-            path.file_name()
-                .expect("file")
-                .to_string_lossy()
-                .into_owned(),
-        );
-        Ok(())
+    let linear_output = |k: usize, t: f64, th: &[f64], c: &crate::operator::Conductance| {
+        on_output(k, t, th, c, model.energy(th))
     };
-    let result = match implicit.as_mut() {
-        Some(stepper) if case.integrator == Integrator::Steady => {
-            stepper.steady(&mut theta, &case.outputs, on_output)
+    let result = match (enthalpic.as_mut(), implicit.as_mut()) {
+        (Some(stepper), _) => {
+            stepper.run(&mut theta, 0.0, dt, &case.outputs, &mut on_output, |s| {
+                progress(s, total)
+            })
         }
-        Some(stepper) => stepper.run(&mut theta, 0.0, dt, &case.outputs, on_output, |s| {
-            progress(s, total)
-        }),
-        None => Explicit::new(&model, case.integrator).run(
+        (None, Some(stepper)) if case.integrator == Integrator::Steady => {
+            stepper.steady(&mut theta, &case.outputs, linear_output)
+        }
+        (None, Some(stepper)) => {
+            stepper.run(&mut theta, 0.0, dt, &case.outputs, linear_output, |s| {
+                progress(s, total)
+            })
+        }
+        (None, None) => Explicit::new(&model, case.integrator).run(
             &mut theta,
             0.0,
             dt,
             &case.outputs,
-            on_output,
+            linear_output,
             |s| progress(s, total),
         ),
     };

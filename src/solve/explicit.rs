@@ -305,7 +305,7 @@ fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
         .for_each(|(i, o)| *o = y[i] + a * k[i]);
 }
 
-fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
+pub(crate) fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
     match theta[..nb].iter().position(|v| !v.is_finite()) {
         Some(node) => Err(Error::NonFinite { node, time: t }),
         None => Ok(()),

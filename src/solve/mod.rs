@@ -1,4 +1,5 @@
 //! Time integration of formulation eq (1).
 
+pub mod enthalpy;
 pub mod explicit;
 pub mod implicit;

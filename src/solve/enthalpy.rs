@@ -1,0 +1,238 @@
+//! Forward Euler in enthalpy form, for models with phase change (seed 001 eqs 3 and 24,
+//! formulation §6).
+//!
+//! Each body node carries its enthalpy per unit volume H_i and θ_i = T(H_i). The step is
+//! `V_i (H_i' − H_i)/Δt = Σ_j λ̄_ij K_ij (θ_j − θ_i) + V_i s_i`, with K the model's pair
+//! conductance for unit conductivity and λ̄_ij the bond rule's mean of the two nodes' λ(H)
+//! (harmonic by default, seed 001 eq 5). λ̄ is symmetric, so energy Σ V_i H_i is conserved by
+//! the bond sum. Buffers are allocated once; the bond sum is a parallel gather.
+
+use crate::error::{Error, Result};
+use crate::material::Enthalpy;
+use crate::model::Model;
+use crate::operator::Conductance;
+use crate::solve::explicit::{check_finite, steps_between, Integrator, RunStats};
+use rayon::prelude::*;
+
+/// Enthalpy-form explicit integrator state with preallocated buffers.
+pub struct Enthalpic<'a> {
+    model: &'a Model,
+    /// Enthalpy relation of every material.
+    relation: &'a [Enthalpy],
+    /// Enthalpy per unit volume of the body nodes, J/m³.
+    h: Vec<f64>,
+    /// Conductivity of every node as the state is now, W/(m·K).
+    lambda: Vec<f64>,
+    /// Enthalpy rate of the body nodes, W/m³.
+    rate: Vec<f64>,
+    /// Unit capacities, so that the boundary's loads come out in W/m³.
+    unit: Vec<f64>,
+    /// K with the conductivities of the last output, W/K (for the heat flux).
+    scaled: Conductance,
+    /// Whether `h` and `lambda` have been set from a temperature field.
+    ready: bool,
+}
+
+impl<'a> Enthalpic<'a> {
+    /// Allocates the buffers for a model with phase change integrated by `integrator`.
+    pub fn new(model: &'a Model, integrator: Integrator) -> Result<Self> {
+        let Some(relation) = model.enthalpy.as_deref() else {
+            return Err(Error::model(
+                "material",
+                "no material changes phase: use the linear explicit integrator",
+            ));
+        };
+        if integrator != Integrator::Euler {
+            return Err(Error::model(
+                "time.integrator",
+                format!(
+                    "phase change runs with forward Euler (seed 001 eq 24), not {}",
+                    integrator.name()
+                ),
+            ));
+        }
+        if !model.growth.is_empty() {
+            return Err(Error::model(
+                "crack",
+                "growing cracks are not supported together with phase change",
+            ));
+        }
+        let nb = model.cloud.n_body;
+        Ok(Enthalpic {
+            model,
+            relation,
+            h: vec![0.0; nb],
+            lambda: vec![0.0; model.cloud.len()],
+            rate: vec![0.0; nb],
+            unit: vec![1.0; nb],
+            scaled: model.conductance.clone(),
+            ready: false,
+        })
+    }
+
+    fn of(&self, i: usize) -> &Enthalpy {
+        &self.relation[self.model.cloud.material[i] as usize]
+    }
+
+    /// Enthalpy per unit volume of the body nodes, J/m³.
+    pub fn enthalpy(&self) -> &[f64] {
+        &self.h
+    }
+
+    /// Total enthalpy of the body, Σ V_i H_i, J (relative to H = 0).
+    pub fn energy(&self) -> f64 {
+        self.h
+            .iter()
+            .zip(&self.model.cloud.volume)
+            .map(|(h, v)| h * v)
+            .sum()
+    }
+
+    /// Melted fraction of every body node (0 frozen … 1 melted).
+    pub fn melted_fraction(&self) -> Vec<f64> {
+        (0..self.h.len())
+            .map(|i| self.of(i).melted_fraction(self.h[i]))
+            .collect()
+    }
+
+    /// Applies the boundary at `t` with the current conductivities and brings H of driven
+    /// nodes and λ of driven and fictitious nodes in line with their new temperatures.
+    fn constrain(&mut self, theta: &mut [f64], t: f64) {
+        let m = self.model;
+        m.boundary
+            .apply_with(&m.cloud, theta, t, Some(&self.lambda));
+        for i in 0..m.cloud.n_body {
+            if m.boundary.driven[i] {
+                let e = *self.of(i);
+                self.h[i] = e.enthalpy(theta[i]);
+                self.lambda[i] = e.conductivity(self.h[i]);
+            }
+        }
+        for i in m.cloud.n_body..m.cloud.len() {
+            let e = self.of(i);
+            self.lambda[i] = e.conductivity(e.enthalpy(theta[i]));
+        }
+    }
+
+    /// Sets H and λ from the temperature field `theta` (all nodes) at time `t`.
+    fn start(&mut self, theta: &mut [f64], t: f64) {
+        for i in 0..self.h.len() {
+            let e = *self.of(i);
+            self.h[i] = e.enthalpy(theta[i]);
+            self.lambda[i] = e.conductivity(self.h[i]);
+        }
+        self.constrain(theta, t);
+        self.ready = true;
+    }
+
+    /// Advances `theta` (all nodes) and the enthalpies from t to t + h, constraints included.
+    /// The first call takes the enthalpies from `theta`.
+    pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        if !self.ready {
+            self.start(theta, t);
+        }
+        let m = self.model;
+        let k = &m.conductance;
+        let rule = m.bond_rule;
+        let (lambda, driven, volume) = (&self.lambda, &m.boundary.driven, &m.cloud.volume);
+        let th: &[f64] = theta;
+        self.rate
+            .par_iter_mut()
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(i, r)| {
+                *r = if driven[i] {
+                    0.0
+                } else {
+                    let (ti, li) = (th[i], lambda[i]);
+                    let row = k.offsets[i]..k.offsets[i + 1];
+                    let mut s = 0.0;
+                    for (&j, &kij) in k.cols[row.clone()].iter().zip(&k.vals[row]) {
+                        let j = j as usize;
+                        s += kij * rule.combine(li, lambda[j]) * (th[j] - ti);
+                    }
+                    s / volume[i]
+                };
+            });
+        if m.boundary.has_loads() {
+            m.boundary
+                .add_loads(&m.cloud, &self.unit, theta, t, &mut self.rate);
+        }
+        let relation = self.relation;
+        let material = &m.cloud.material;
+        theta[..self.h.len()]
+            .par_iter_mut()
+            .with_min_len(4096)
+            .zip(self.h.par_iter_mut())
+            .zip(self.lambda.par_iter_mut())
+            .zip(&self.rate)
+            .enumerate()
+            .for_each(|(i, (((y, hi), li), r))| {
+                if !driven[i] {
+                    let e = &relation[material[i] as usize];
+                    *hi += h * r;
+                    *y = e.temperature(*hi);
+                    *li = e.conductivity(*hi);
+                }
+            });
+        self.constrain(theta, t + h);
+    }
+
+    /// K with the current conductivities, K_ij = λ̄_ij K_ij(λ = 1), W/K.
+    fn scale_conductance(&mut self) {
+        let k = &self.model.conductance;
+        let rule = self.model.bond_rule;
+        for i in 0..k.n_rows() {
+            let mut d = 0.0;
+            for e in k.offsets[i]..k.offsets[i + 1] {
+                let j = k.cols[e] as usize;
+                let v = k.vals[e] * rule.combine(self.lambda[i], self.lambda[j]);
+                self.scaled.vals[e] = v;
+                d += v;
+            }
+            self.scaled.diag[i] = d;
+        }
+    }
+
+    /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K, E)` there
+    /// (K with the conductivities of that moment, E = Σ V_i H_i in J) and `progress(steps)` now
+    /// and then. Steps never exceed `dt` and land on the output times.
+    pub fn run(
+        &mut self,
+        theta: &mut [f64],
+        t0: f64,
+        dt: f64,
+        outputs: &[f64],
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance, f64) -> Result<()>,
+        mut progress: impl FnMut(u64),
+    ) -> Result<RunStats> {
+        if !self.ready {
+            self.start(theta, t0);
+        }
+        let mut t = t0;
+        let mut stats = RunStats::default();
+        let nb = self.model.cloud.n_body;
+        for (k, &to) in outputs.iter().enumerate() {
+            let n = steps_between(t, to, dt);
+            let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
+            for s in 0..n {
+                let tn = t + s as f64 * h;
+                self.step(theta, tn, h);
+                stats.steps += 1;
+                if stats.steps % 256 == 0 {
+                    progress(stats.steps);
+                    if stats.steps % 4096 == 0 {
+                        check_finite(theta, nb, tn + h)?;
+                    }
+                }
+            }
+            t = to;
+            check_finite(theta, nb, t)?;
+            self.scale_conductance();
+            let energy = self.energy();
+            on_output(k, t, theta, &self.scaled, energy)?;
+        }
+        progress(stats.steps);
+        Ok(stats)
+    }
+}
