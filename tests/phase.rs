@@ -296,7 +296,7 @@ end = 172800.0
         let front = x[k - 1] + (0.5 - f[k - 1]) / (f[k] - f[k - 1]) * (x[k] - x[k - 1]);
         let exact = neumann_front(&neumann, t).unwrap();
         worst = worst.max((front - exact).abs());
-        if (to as u64) % 43200 == 0 {
+        if (to as u64).is_multiple_of(43200) {
             println!(
                 "t = {} h: front {front:.4} m, Neumann {exact:.4} m",
                 to / 3600.0

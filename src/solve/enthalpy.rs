@@ -101,25 +101,26 @@ impl<'a> Enthalpic<'a> {
         let m = self.model;
         m.boundary
             .apply_with(&m.cloud, theta, t, Some(&self.lambda));
-        for i in 0..m.cloud.n_body {
-            if m.boundary.driven[i] {
-                let e = *self.of(i);
-                self.h[i] = e.enthalpy(theta[i]);
-                self.lambda[i] = e.conductivity(self.h[i]);
+        let relation = self.relation;
+        let material = &m.cloud.material;
+        for (i, (&th, l)) in theta.iter().zip(self.lambda.iter_mut()).enumerate() {
+            let e = &relation[material[i] as usize];
+            if i >= m.cloud.n_body {
+                *l = e.conductivity(e.enthalpy(th));
+            } else if m.boundary.driven[i] {
+                self.h[i] = e.enthalpy(th);
+                *l = e.conductivity(self.h[i]);
             }
-        }
-        for i in m.cloud.n_body..m.cloud.len() {
-            let e = self.of(i);
-            self.lambda[i] = e.conductivity(e.enthalpy(theta[i]));
         }
     }
 
     /// Sets H and λ from the temperature field `theta` (all nodes) at time `t`.
     fn start(&mut self, theta: &mut [f64], t: f64) {
-        for i in 0..self.h.len() {
-            let e = *self.of(i);
-            self.h[i] = e.enthalpy(theta[i]);
-            self.lambda[i] = e.conductivity(self.h[i]);
+        let (relation, material) = (self.relation, &self.model.cloud.material);
+        for (i, (h, l)) in self.h.iter_mut().zip(self.lambda.iter_mut()).enumerate() {
+            let e = &relation[material[i] as usize];
+            *h = e.enthalpy(theta[i]);
+            *l = e.conductivity(*h);
         }
         self.constrain(theta, t);
         self.ready = true;
