@@ -309,3 +309,33 @@ fn cli_plot_writes_maps_and_refuses_3d() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("2D") && err.contains(".vtu"), "{err}");
 }
+
+/// The isoline of a field that is linear on each cell is exact: for θ = 3x + y on a
+/// cell-centred lattice, every segment of θ = 1.7 has both ends on the line 3x + y = 1.7
+/// (1e-12: interpolation round-off), and the segments join up to the line's length across
+/// the lattice's convex hull (marching squares covers every cell the line crosses).
+#[test]
+fn isoline_of_a_linear_field_lies_on_the_line() {
+    use peritherm::plot::isoline;
+    let h = 0.05;
+    let mut pos = Vec::new();
+    for j in 0..20 {
+        for i in 0..20 {
+            pos.push(Point::new((i as f64 + 0.5) * h, (j as f64 + 0.5) * h, 0.0));
+        }
+    }
+    let value: Vec<f64> = pos.iter().map(|p| 3.0 * p.x + p.y).collect();
+    let spacing = vec![h; pos.len()];
+    let segs = isoline(&pos, &value, &spacing, 1.7);
+    assert!(!segs.is_empty());
+    let mut length = 0.0;
+    for s in &segs {
+        for p in s {
+            assert!((3.0 * p.x + p.y - 1.7).abs() < 1e-12);
+        }
+        length += (s[1] - s[0]).norm();
+    }
+    // the line crosses y ∈ [0.025, 0.975] between the outer node rows: Δy = 0.95, Δx = Δy/3
+    let expected = 0.95 * (1.0f64 + 1.0 / 9.0).sqrt();
+    assert!((length - expected).abs() < 1e-9, "{length} vs {expected}");
+}

@@ -51,10 +51,59 @@ pub struct FieldMap<'a> {
     pub flux_unit: String,
     /// Arrow grid cells along the longer side of the map (20 by default).
     pub arrows: usize,
+    /// Isoline segments (e.g. a phase front, [`isoline`]), drawn as thin dark-red lines.
+    pub isolines: &'a [[Point; 2]],
     /// Side of each node's square in spacings; None (the default): 1 on a lattice cloud,
     /// [`IRREGULAR_SQUARE`] when the nearest neighbours are not at distance Δ (mesh clouds),
     /// so that the squares leave no holes.
     pub square: Option<f64>,
+}
+
+/// Segments of the isoline `value = level` by marching squares over the lattice cells of a 2D
+/// cloud: every square of four nodes at (x, y), (x + Δ, y), (x, y + Δ), (x + Δ, y + Δ) with
+/// one spacing Δ, the crossing on each edge between a node at or below `level` and one above
+/// it placed by linear interpolation (so a phase front at T_f bounds the liquid, whose nodes
+/// alone lie above T_f). Cells that are not such squares (region interfaces, mesh clouds) are
+/// skipped.
+pub fn isoline(pos: &[Point], value: &[f64], spacing: &[f64], level: f64) -> Vec<[Point; 2]> {
+    use std::collections::HashMap;
+    // half-spacing units: cell-centred nodes sit at odd multiples of Δ/2, never on a rounding tie
+    let key = |p: &Point, h: f64| {
+        (
+            (2.0 * p.x / h).round() as i64,
+            (2.0 * p.y / h).round() as i64,
+            h.to_bits(),
+        )
+    };
+    let index: HashMap<(i64, i64, u64), usize> = pos
+        .iter()
+        .zip(spacing)
+        .enumerate()
+        .map(|(i, (p, &h))| (key(p, h), i))
+        .collect();
+    let mut out = Vec::new();
+    for (i, (p, &h)) in pos.iter().zip(spacing).enumerate() {
+        let (a, b, hb) = key(p, h);
+        let corner = |da: i64, db: i64| index.get(&(a + da, b + db, hb)).copied();
+        let (Some(i1), Some(i2), Some(i3)) = (corner(2, 0), corner(2, 2), corner(0, 2)) else {
+            continue;
+        };
+        // corners counter-clockwise; the crossings on the edges whose ends straddle `level`
+        let c = [i, i1, i2, i3];
+        let mut cross = Vec::with_capacity(4);
+        for e in 0..4 {
+            let (u, v) = (c[e], c[(e + 1) % 4]);
+            let (fu, fv) = (value[u] - level, value[v] - level);
+            if (fu <= 0.0) != (fv <= 0.0) {
+                let w = fu / (fu - fv);
+                cross.push(pos[u] + (pos[v] - pos[u]) * w);
+            }
+        }
+        for pair in cross.chunks_exact(2) {
+            out.push([pair[0], pair[1]]);
+        }
+    }
+    out
 }
 
 /// Side of the squares, in spacings, on clouds that are not lattices.
@@ -96,6 +145,7 @@ impl<'a> FieldMap<'a> {
             colour_map: ColourMap::Diverging,
             range: None,
             cracks: &[],
+            isolines: &[],
             regions: None,
             flux: None,
             flux_unit: "W/m²".into(),
@@ -362,6 +412,12 @@ impl Figure for MapFigure<'_> {
                 )
             })
         }))?;
+        let front = RGBColor(150, 0, 20).stroke_width(2);
+        chart.draw_series(
+            map.isolines
+                .iter()
+                .map(|s| PathElement::new(vec![(s[0].x, s[0].y), (s[1].x, s[1].y)], front)),
+        )?;
         let mut longest = 0.0;
         if let Some(flux) = map.flux {
             let (lines, qmax) = arrows(map, flux, self.x, self.y);

@@ -12,7 +12,7 @@ mod map;
 pub use colour::ColourMap;
 pub use convergence::{convergence_plot, fit_power_law, fit_rate, PowerLaw};
 pub use line::{line_plot, Legend, Series, Style};
-pub use map::{field_map, FieldMap, IRREGULAR_SQUARE};
+pub use map::{field_map, isoline, FieldMap, IRREGULAR_SQUARE};
 
 use crate::error::{Error, Result};
 use plotters::coord::Shift;

@@ -5,9 +5,12 @@
 use crate::case::Case;
 use crate::crack::segments_at;
 use crate::error::Result;
+use crate::math::Point;
 use crate::model::crack_cutters;
 use crate::output::{read_field, write_atomic, FieldRows, RunSummary};
-use crate::plot::{field_map, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style};
+use crate::plot::{
+    field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
+};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -120,9 +123,22 @@ pub fn draw_maps(
     for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
         let cracks = segments_at(&cutters, *t);
         let several_regions = f.region.iter().any(|&r| r != f.region[0]);
+        // phase fronts: the isotherms at each phase-change temperature (seed 001 Fig. 13)
+        let fronts: Vec<[Point; 2]> = case
+            .spec
+            .materials
+            .iter()
+            .filter_map(|m| m.phase_change.map(|p| p.temperature))
+            .flat_map(|tf| isoline(&f.pos, &f.theta, &f.spacing, tf))
+            .collect();
         let mut map = FieldMap::new(&f.pos, &f.theta, &f.spacing);
+        map.isolines = &fronts;
         map.title = format!("{name}: temperature at t = {t} s");
-        map.quantity = "Temperature (°C)".into();
+        map.quantity = if fronts.is_empty() {
+            "Temperature (°C)".into()
+        } else {
+            "Temperature (°C); dark red: the phase front".into()
+        };
         map.range = range;
         map.cracks = &cracks;
         map.regions = several_regions.then_some(&f.region[..]);
