@@ -30,6 +30,9 @@ end = 2.0
 outputs = [1.0, 2.0]
 "#;
 
+/// A phase change for SMALL's material (melting at 500 °C, never reached).
+const PHASE: &str = "[material.steel.phase_change]\ntemperature = 500.0\nlatent_heat = 3e5\nfrozen_conductivity = 40.0\nfrozen_specific_heat = 400.0\n";
+
 fn peritherm(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_peritherm"))
         .args(args)
@@ -160,6 +163,38 @@ fn bad_input_fails_with_one_clear_line() {
             "output time",
             SMALL.replace("outputs = [1.0, 2.0]", "outputs = [2.0, 1.0]"),
             "time.outputs[1]",
+        ),
+        (
+            "negative latent heat",
+            SMALL.replace("[boundary.x_min]", &format!("{PHASE}[boundary.x_min]"))
+                .replace("latent_heat = 3e5", "latent_heat = -3e5"),
+            "material.steel.phase_change.latent_heat",
+        ),
+        (
+            "phase change with rk4",
+            SMALL
+                .replace("[boundary.x_min]", &format!("{PHASE}[boundary.x_min]"))
+                .replace("[time]", "[time]\nintegrator = \"rk4\""),
+            "time.integrator",
+        ),
+        (
+            "axisymmetric with thickness",
+            SMALL.replace("dimension = 2", "dimension = 2\nsymmetry = \"axisymmetric\""),
+            "domain.thickness",
+        ),
+        (
+            "spherical in 2D",
+            SMALL
+                .replace("dimension = 2", "dimension = 2\nsymmetry = \"spherical\"")
+                .replace("thickness = 0.1\n", ""),
+            "symmetry",
+        ),
+        (
+            "layer at the axis",
+            SMALL
+                .replace("dimension = 2", "dimension = 2\nsymmetry = \"axisymmetric\"")
+                .replace("thickness = 0.1\n", ""),
+            "symmetry",
         ),
     ];
     for (what, text, key) in cases {
