@@ -72,6 +72,19 @@ pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
             m
         }
     };
+    mesh.symmetry = spec.symmetry;
+    if spec.symmetry.is_symmetric() {
+        if let Some(p) = mesh.nodes.iter().find(|p| p.x < 0.0) {
+            return Err(Error::model(
+                "symmetry",
+                format!(
+                    "fem: {} model: a mesh node lies at r = x = {:e} < 0; the body must lie at x ≥ 0 (x is the radius)",
+                    spec.symmetry.name(),
+                    p.x
+                ),
+            ));
+        }
+    }
     let keys = crack_facets(&mesh, &spec.cracks)?;
     let added = split(&mut mesh, &keys);
     Ok((mesh, added))
