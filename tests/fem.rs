@@ -930,6 +930,9 @@ fn steady_error(text: &str, h: f64, exact: &dyn Fn(f64, f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// An exact solution θ(x, y), °C.
+type Exact = Box<dyn Fn(f64, f64) -> f64>;
+
 /// A symmetric body on r ∈ [0.5, 1] (1D) or [0.5, 1] × [0, 0.25] (2D, z faces insulated)
 /// with k = 4 and the given boundary tables.
 fn radial(symmetry: &str, dim: usize, faces: &str) -> String {
@@ -965,10 +968,10 @@ fn symmetric_steady_states_converge_at_second_order() {
     let held = "[boundary.x_min]\ntype = \"temperature\"\nvalue = 100.0\n[boundary.x_max]\ntype = \"temperature\"\nvalue = 0.0";
     let flux = "[boundary.x_min]\ntype = \"flux\"\nvalue = 50.0\n[boundary.x_max]\ntype = \"temperature\"\nvalue = 0.0";
     let conv = "[boundary.x_min]\ntype = \"temperature\"\nvalue = 100.0\n[boundary.x_max]\ntype = \"convection\"\nmethod = \"mirror\"\nh = 8.0\nambient = 20.0";
-    let log_profile = |x: f64, _: f64| 100.0 * (1.0 - (x / a).ln() / (b / a).ln());
+    let log_profile = move |x: f64, _: f64| 100.0 * (1.0 - (x / a).ln() / (b / a).ln());
     let c_conv = -8.0 * (100.0 - 20.0) / (k / b + 8.0 * (b / a).ln());
     let bb = 100.0 * a * b / (b - a);
-    let checks: Vec<(&str, String, Box<dyn Fn(f64, f64) -> f64>)> = vec![
+    let checks: Vec<(&str, String, Exact)> = vec![
         (
             "axisymmetric 1D, held",
             radial("axisymmetric", 1, held),
