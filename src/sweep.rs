@@ -245,7 +245,8 @@ pub struct Row {
     pub mean_abs: Option<f64>,
     /// Seed 003 eq 13 along the case's probe line (classical references only).
     pub eq13: Option<f64>,
-    /// Seed 001 eq 27 (classical references only).
+    /// Seed 001 eq 27: rms difference / max |θ_ref| (the other run's field is the reference
+    /// when comparing with a run).
     pub epsilon: Option<f64>,
     /// What it is compared with.
     pub against: String,
@@ -429,6 +430,7 @@ pub fn run(
                 time: *t,
                 max_abs: d.max_abs,
                 mean_abs: Some(d.mean_abs),
+                epsilon: Some(d.epsilon()),
                 against: reference_dir.display().to_string(),
                 ..base.clone()
             });
