@@ -360,6 +360,9 @@ pub struct FemReferenceSpec {
     /// Time step, s (default: min(end/1000, first output/100)).
     #[serde(default)]
     pub dt: Option<f64>,
+    /// Another gmsh file (same group names) to solve a gmsh case on, relative to the case file.
+    #[serde(default)]
+    pub mesh: Option<PathBuf>,
 }
 
 /// Where the classical temperatures of a reference come from.
@@ -484,6 +487,9 @@ fn reference(
                 h: f.h,
                 scheme: f.scheme.unwrap_or(Scheme::CrankNicolson),
                 dt: f.dt,
+                mesh: f
+                    .mesh
+                    .map(|m| path.parent().unwrap_or(Path::new(".")).join(m)),
             })
         }
         (None, Some(file), None) => {

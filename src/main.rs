@@ -226,7 +226,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 )
                 .expect("valid template"),
             );
-            let opts = FemOptions { h, scheme, dt };
+            let opts = FemOptions {
+                h,
+                scheme,
+                dt,
+                mesh: None,
+            };
             let summary = run_fem(&case, &out, &opts, |done, total| {
                 bar.set_length(total);
                 bar.set_position(done);

@@ -1097,3 +1097,79 @@ fn sphere_converges_at_second_order() {
         "rates {rc:?}, errors {centre:?}"
     );
 }
+
+/// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names.
+/// The pipe section of seed 001 §3.4 on quads of 0.04 m solved on the quads of 0.02 m: the
+/// other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long, the
+/// insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
+/// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's
+/// region, or `mesh` on a box case, is refused with one line naming the file and the key.
+#[test]
+fn reference_fem_mesh_solves_on_another_mesh() {
+    let text = std::fs::read_to_string(root().join("cases/pipe_heating_2d.toml"))
+        .unwrap()
+        .replace("pipe_heating_d0.02.msh", "pipe_heating_d0.04.msh")
+        .replace("pipe_heating_fem.msh", "pipe_heating_d0.02.msh");
+    let c = case(&text);
+    let opts = match &c.reference.as_ref().unwrap().source {
+        peritherm::case::ReferenceSource::Fem(o) => o.clone(),
+        _ => panic!("a FEM reference"),
+    };
+    let model = FemModel::build_with(&c, &opts).unwrap();
+    assert_eq!(model.mesh.nodes.len(), 41 * 41);
+    let length = |s: usize| -> f64 {
+        model.mesh.sets[s]
+            .iter()
+            .map(|&f| {
+                let n: Vec<u32> = model.mesh.facet_nodes(f).collect();
+                (model.mesh.nodes[n[0] as usize] - model.mesh.nodes[n[1] as usize]).norm()
+            })
+            .sum()
+    };
+    assert!((length(0) - 0.2).abs() < 1e-12, "heated {}", length(0));
+    assert!((length(1) - 3.0).abs() < 1e-12, "insulated {}", length(1));
+    let volume: f64 = model.system.measure.iter().sum();
+    let exact = std::f64::consts::PI * (1.2f64.powi(2) - 0.4f64.powi(2)) * 0.8;
+    assert!(
+        (volume - exact).abs() < 1e-12 * exact,
+        "{volume} vs {exact}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let bad = [
+        (
+            text.replace("pipe_heating_d0.02.msh", "annulus.msh"),
+            "no 2D physical group `pipe`",
+        ),
+        (
+            SQUARE.replace(
+                "[reference.solution]",
+                "[reference.fem]\nmesh = \"../meshes/annulus.msh\"\n[reference.x]",
+            )
+            .replace("[reference.x]\nkind = \"square_fixed_edges\"\nx0 = 0.0\ny0 = 0.0\nlength = 1.0\ndiffusivity = 1.14\nedge = 0.0\ninitial = 40.0\n", ""),
+            "applies to a gmsh case",
+        ),
+    ];
+    let meshes = format!("\"{}/", root().join("meshes").display());
+    for (text, what) in bad {
+        let path = PathBuf::from(write_case(
+            dir.path(),
+            &text.replace("\"../meshes/", &meshes),
+        ));
+        let o = peritherm(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            dir.path().join("out").to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{what}: succeeded");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(
+            err.contains(path.to_str().unwrap())
+                && err.contains("reference.fem.mesh")
+                && err.contains(what),
+            "{err}"
+        );
+    }
+}
