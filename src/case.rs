@@ -930,6 +930,15 @@ impl CaseFile {
                 ),
             ));
         }
+        if self.symmetry.is_symmetric() && self.kernel.linear_consistency {
+            return Err(err(
+                "kernel.linear_consistency",
+                format!(
+                    "does not apply with symmetry = \"{}\": the correction zeroes every node's first moment Σ K_ij ξ_ij, which the ring/shell pair factors must keep (it carries the (1/r)∂θ/∂r term, seed 001 eqs 10, 21)",
+                    self.symmetry.name()
+                ),
+            ));
+        }
         if self.symmetry.is_symmetric() && (thickness.is_some() || area.is_some()) {
             return Err(err(
                 &format!("{section}.{}", if dim == 1 { "area" } else { "thickness" }),
