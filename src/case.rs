@@ -356,6 +356,9 @@ pub struct FemReferenceSpec {
     /// Time step, s (default: min(end/1000, first output/100)).
     #[serde(default)]
     pub dt: Option<f64>,
+    /// Another gmsh file (same group names) to solve a gmsh case on, relative to the case file.
+    #[serde(default)]
+    pub mesh: Option<PathBuf>,
 }
 
 /// Where the classical temperatures of a reference come from.
@@ -480,6 +483,9 @@ fn reference(
                 h: f.h,
                 scheme: f.scheme.unwrap_or(Scheme::CrankNicolson),
                 dt: f.dt,
+                mesh: f
+                    .mesh
+                    .map(|m| path.parent().unwrap_or(Path::new(".")).join(m)),
             })
         }
         (None, Some(file), None) => {
@@ -917,6 +923,15 @@ impl CaseFile {
                     } else {
                         "1 or 2"
                     }
+                ),
+            ));
+        }
+        if self.symmetry.is_symmetric() && self.kernel.linear_consistency {
+            return Err(err(
+                "kernel.linear_consistency",
+                format!(
+                    "does not apply with symmetry = \"{}\": the correction zeroes every node's first moment Σ K_ij ξ_ij, which the ring/shell pair factors must keep (it carries the (1/r)∂θ/∂r term, seed 001 eqs 10, 21)",
+                    self.symmetry.name()
                 ),
             ));
         }

@@ -226,7 +226,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 )
                 .expect("valid template"),
             );
-            let opts = FemOptions { h, scheme, dt };
+            let opts = FemOptions {
+                h,
+                scheme,
+                dt,
+                mesh: None,
+            };
             let summary = run_fem(&case, &out, &opts, |done, total| {
                 bar.set_length(total);
                 bar.set_position(done);
@@ -320,11 +325,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
 fn print_comparisons(summary: &RunSummary) {
     for c in &summary.reference {
         say!(
-            "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}",
+            "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}  ε(eq27) = {:.4e}",
             c.time,
             c.max_abs_diff,
             c.mean_sq_rel_diff,
-            c.l2_rel_line
+            c.l2_rel_line,
+            c.epsilon
         );
     }
 }
@@ -360,8 +366,8 @@ fn compare(
         );
     }
     say!();
-    say!("| t (s) | max abs diff (°C) | mean abs diff (°C) | where (m) |");
-    say!("|---|---|---|---|");
+    say!("| t (s) | max abs diff (°C) | mean abs diff (°C) | ε (eq 27) | where (m) |");
+    say!("|---|---|---|---|---|");
     for (k, t) in a.output_times.iter().enumerate() {
         let Some(kb) = b
             .output_times
@@ -381,9 +387,10 @@ fn compare(
             (&tips, exclude_tips),
         );
         say!(
-            "| {t} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",
+            "| {t} | {:.3e} | {:.3e} | {:.3e} | ({:.4e}, {:.4e}, {:.4e}) |",
             d.max_abs,
             d.mean_abs,
+            d.epsilon(),
             d.at.x,
             d.at.y,
             d.at.z

@@ -3,7 +3,7 @@
 //! compared with a reference (formulation §9): the case's own `[reference]`, another run, or
 //! the first variant.
 
-use crate::case::Case;
+use crate::case::{Case, ReferenceSource};
 use crate::crack::tips_at;
 use crate::error::{Error, Result};
 use crate::model::crack_cutters;
@@ -245,7 +245,8 @@ pub struct Row {
     pub mean_abs: Option<f64>,
     /// Seed 003 eq 13 along the case's probe line (classical references only).
     pub eq13: Option<f64>,
-    /// Seed 001 eq 27 (classical references only).
+    /// Seed 001 eq 27: rms difference / max |θ_ref| (the other run's field is the reference
+    /// when comparing with a run).
     pub epsilon: Option<f64>,
     /// What it is compared with.
     pub against: String,
@@ -354,7 +355,20 @@ pub fn run(
     for (k, v) in variants.iter().enumerate() {
         progress(k, &v.label);
         let dir = out.join(&v.label);
-        let summary = run_case(&v.case, &dir, |_, _| {})?;
+        // compared with another run, a variant's own [reference.fem] (solved again for every
+        // variant, the measures not using it) is left out
+        let own_fem = v
+            .case
+            .reference
+            .as_ref()
+            .is_some_and(|r| matches!(r.source, ReferenceSource::Fem(_)));
+        let summary = if own_fem && matches!(against, Against::Run(_)) {
+            let mut case = v.case.clone();
+            case.reference = None;
+            run_case(&case, &dir, |_, _| {})?
+        } else {
+            run_case(&v.case, &dir, |_, _| {})?
+        };
         let cloud = v.case.spec.geometry.bare_cloud()?;
         let finest = (0..cloud.n_body)
             .min_by(|&a, &b| cloud.horizon[a].total_cmp(&cloud.horizon[b]))
@@ -429,6 +443,7 @@ pub fn run(
                 time: *t,
                 max_abs: d.max_abs,
                 mean_abs: Some(d.mean_abs),
+                epsilon: Some(d.epsilon()),
                 against: reference_dir.display().to_string(),
                 ..base.clone()
             });

@@ -6,10 +6,15 @@
 //! only matches it on uniform meshes), and it conserves ∫ρcθ dV = 1ᵀMθ exactly like a lumped
 //! one, since K 1 = 0 for an insulated body. Its row sums (the lumped capacities) are kept
 //! for the energy and the `volume` column.
+//!
+//! Axisymmetric and spherical meshes (x = r) weight every integrand by 2πr or 4πr² at the
+//! quadrature point ([`FemMesh::symmetry_weight`]): K_ab = ∫ k ∇N_a·∇N_b 2πr dr dz is the
+//! Galerkin form of ρc θ_t = (1/r)(r k θ_r)_r + (k θ_z)_z (and of (1/r²)(r² k θ_r)_r).
 
 use super::mesh::FemMesh;
-use super::shape::{physical, quadrature, shape, MAX_NODES};
+use super::shape::{physical, quadrature_for, shape, MAX_NODES};
 use crate::material::Material;
+use crate::math::{Point, Vector};
 use rayon::prelude::*;
 
 /// Entries per element matrix slot (8 × 8).
@@ -64,10 +69,12 @@ fn element(
     let n = c.kind.n_nodes();
     let x = mesh.corners(c);
     let (mut ke, mut me, mut ve) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; MAX_NODES]);
-    for &(xi, w) in quadrature(c.kind) {
+    for &(xi, w) in quadrature_for(c.kind, mesh.symmetry) {
         let s = shape(c.kind, xi);
         let (g, det) = physical(c.kind, &s, &x, mesh.dim);
-        let dv = w * det * mesh.tau;
+        // ring/shell measure at the quadrature point (seed 001 §2.2–2.3): 2πr or 4πr² dr
+        let at = Point::from((0..n).map(|a| x[a].coords * s.n[a]).sum::<Vector>());
+        let dv = w * det * mesh.tau * mesh.symmetry_weight(&at);
         for a in 0..n {
             ve[a] += s.n[a] * dv;
             for b in 0..n {

@@ -4,11 +4,13 @@
 //! condition on the nodes of the set's facets, imposed strongly by elimination; `insulated`
 //! and `free` are the natural condition (nothing to add); `flux` (either method) is the load
 //! ∫ q N_i dS; `convection` adds ∫ h N_i N_j dS to K and ∫ h T∞ N_i dS to the load; a
-//! volumetric source is the load ∫ s N_i dV. Out-of-plane measures τ multiply every integral.
+//! volumetric source is the load ∫ s N_i dV. Out-of-plane measures τ multiply every integral,
+//! and on axisymmetric or spherical meshes so does the ring or shell measure 2πr or 4πr² at
+//! each quadrature point (a flux q on the face r = a loads 2πa q per unit length of axis).
 
 use super::assemble::System;
 use super::mesh::{FacetRef, FemMesh};
-use super::shape::{facet_density, physical, quadrature, shape, MAX_NODES};
+use super::shape::{facet_density, physical, quadrature, quadrature_for, shape, MAX_NODES};
 use crate::bc::FaceBc;
 use crate::expr::Expr;
 use crate::math::Point;
@@ -78,7 +80,7 @@ fn facet_points(mesh: &FemMesh, f: FacetRef) -> Vec<QPoint> {
             );
             QPoint {
                 pos,
-                weight: w * facet_density(kind, &s, &x[..len]) * tau,
+                weight: w * facet_density(kind, &s, &x[..len]) * tau * mesh.symmetry_weight(&pos),
                 nodes,
                 n: s.n,
                 len: len as u8,
@@ -92,7 +94,7 @@ fn cell_points(mesh: &FemMesh) -> Vec<QPoint> {
     for c in &mesh.cells {
         let x = mesh.corners(c);
         let len = c.kind.n_nodes();
-        for &(xi, w) in quadrature(c.kind) {
+        for &(xi, w) in quadrature_for(c.kind, mesh.symmetry) {
             let s = shape(c.kind, xi);
             let (_, det) = physical(c.kind, &s, &x, mesh.dim);
             let pos = Point::from(
@@ -102,7 +104,7 @@ fn cell_points(mesh: &FemMesh) -> Vec<QPoint> {
             );
             out.push(QPoint {
                 pos,
-                weight: w * det * mesh.tau,
+                weight: w * det * mesh.tau * mesh.symmetry_weight(&pos),
                 nodes: c.nodes,
                 n: s.n,
                 len: len as u8,

@@ -3,7 +3,8 @@
 //! the recovered heat flux.
 //!
 //! At a FEM node: `spacing` = mean size (measure^(1/d)) of the cells around it, `horizon` = 0,
-//! `volume` = lumped nodal measure ∫N_i dV, `damage` = 0, `region` = the region of the first
+//! `volume` = lumped nodal measure ∫N_i dV (ring or shell volume when the mesh is
+//! axisymmetric or spherical), `damage` = 0, `region` = the region of the first
 //! cell around it, and q = −k∇θ taken at the centre of every cell around the node and averaged
 //! with the cells' measures as weights, W/m².
 //!
@@ -117,6 +118,7 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
         n_body: nn,
         min: lo,
         max: hi,
+        symmetry: mesh.symmetry,
         ..Default::default()
     };
     (

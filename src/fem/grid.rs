@@ -187,6 +187,7 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
         nodes,
         cells,
         sets: vec![Vec::new(); 6],
+        symmetry: crate::symmetry::Symmetry::Planar,
     };
     // boundary facets: facets of one cell only, classified by the face plane they lie on
     let map = m.facet_map();

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::math::Point;
 use crate::mesh::ElementKind;
 use crate::spatial::PointIndex;
+use crate::symmetry::Symmetry;
 use std::collections::HashMap;
 
 /// One cell: its kind, node indices (the first `kind.n_nodes()` are used), region and material.
@@ -51,6 +52,9 @@ pub struct FemMesh {
     pub cells: Vec<Cell>,
     /// Boundary facets of each boundary set (box faces x_min … z_max, or the mesh's groups).
     pub sets: Vec<Vec<FacetRef>>,
+    /// Planar, or axisymmetric / spherical about x = 0 (x = r): every volume and facet
+    /// integral is weighted by [`Symmetry::volume_factor`] (1, 2πr or 4πr², m⁰/m/m²).
+    pub symmetry: Symmetry,
 }
 
 impl FemMesh {
@@ -100,6 +104,13 @@ impl FemMesh {
             }
         }
         (count, out)
+    }
+
+    /// Weight of a quadrature point at `p` from the body's symmetry: 1 (planar), 2πr or 4πr²
+    /// with r = x (seed 001 ring and shell measures), m⁰, m or m².
+    #[inline]
+    pub fn symmetry_weight(&self, p: &Point) -> f64 {
+        self.symmetry.volume_factor(p.x)
     }
 
     /// Corner positions of a cell.
@@ -152,6 +163,7 @@ impl FemMesh {
             nodes,
             cells,
             sets: Vec::new(),
+            symmetry: Symmetry::Planar,
         };
         let map = m.facet_map();
         for gr in g.set_groups() {

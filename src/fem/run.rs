@@ -8,19 +8,21 @@ use super::grid::box_mesh;
 use super::mesh::FemMesh;
 use super::solve::{Scheme, Stepper};
 use super::split::{check_cracks, crack_facets, split};
+use crate::bc::FaceBc;
 use crate::case::Case;
 use crate::case::ReferenceSource;
+use crate::cloud::mesh::{MeshGeometry, MeshRegion};
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
 use crate::math::Vector;
-use crate::model::{crack_cutters, Geometry};
+use crate::model::{crack_cutters, CrackShape, Geometry};
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
 use crate::report::{classical_at, compare};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Settings of a FEM run that the case file does not hold.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FemOptions {
     /// Element size of the structured mesh of a box case, m (default: the finest region spacing).
     pub h: Option<f64>,
@@ -28,6 +30,9 @@ pub struct FemOptions {
     pub scheme: Scheme,
     /// Time step, s (default [`default_dt`]); steps shrink to land on every output time.
     pub dt: Option<f64>,
+    /// Another gmsh file to solve a gmsh case on (e.g. finer, or graded towards a singular
+    /// point), with the same physical group names; default the case's own mesh.
+    pub mesh: Option<PathBuf>,
 }
 
 impl Default for FemOptions {
@@ -36,6 +41,7 @@ impl Default for FemOptions {
             h: None,
             scheme: Scheme::CrankNicolson,
             dt: None,
+            mesh: None,
         }
     }
 }
@@ -47,11 +53,90 @@ pub fn default_dt(case: &Case) -> f64 {
     (case.end / 1000.0).min(first / 100.0)
 }
 
+/// The FEM mesh of a gmsh case read from another file `file`: the case's regions and
+/// boundary sets found by name in it (the sets in the case's order; a set the file lacks is
+/// empty, which is an error unless the case leaves it free and no crack uses it).
+fn other_mesh(case: &Case, g: &MeshGeometry, file: &Path) -> Result<FemMesh> {
+    let key = "reference.fem.mesh";
+    let other = crate::gmsh::read(file).map_err(|e| Error::model(key, e.to_string()))?;
+    let name_of = |m: &crate::mesh::Mesh, gr: usize| m.groups[gr].name.clone();
+    let mut regions = Vec::with_capacity(g.regions.len());
+    for r in &g.regions {
+        let group = other.group(g.dim(), &r.name).ok_or_else(|| {
+            Error::model(
+                key,
+                format!(
+                    "{}: has no {}D physical group `{}` (a region of the case)",
+                    file.display(),
+                    g.dim(),
+                    r.name
+                ),
+            )
+        })?;
+        regions.push(MeshRegion { group, ..r.clone() });
+    }
+    let geometry = MeshGeometry {
+        mesh: std::sync::Arc::new(other),
+        regions,
+        ..g.clone()
+    };
+    let mut m = FemMesh::from_gmsh(&geometry)?;
+    m.check_conforming()?;
+    let have = geometry.set_names();
+    let mut sets = Vec::new();
+    for (s, name) in g.set_names().iter().enumerate() {
+        match have.iter().position(|n| n == name) {
+            Some(k) => sets.push(std::mem::take(&mut m.sets[k])),
+            None if matches!(case.spec.faces.get(s), None | Some(FaceBc::Free))
+                && !case
+                    .spec
+                    .cracks
+                    .iter()
+                    .any(|c| matches!(c.shape, CrackShape::Set(k) if k == s)) =>
+            {
+                sets.push(Vec::new())
+            }
+            None => {
+                return Err(Error::model(
+                    key,
+                    format!(
+                        "{}: has no physical group `{name}` (a boundary of the case); it has {:?}",
+                        file.display(),
+                        geometry
+                            .set_groups()
+                            .iter()
+                            .map(|&gr| name_of(&geometry.mesh, gr))
+                            .collect::<Vec<_>>()
+                    ),
+                ))
+            }
+        }
+    }
+    m.sets = sets;
+    Ok(m)
+}
+
 /// The FEM mesh of a case (split along its cracks) and the number of nodes the split added.
-pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
+pub fn build_mesh(case: &Case, opts: &FemOptions) -> Result<(FemMesh, usize)> {
     let spec = &case.spec;
+    let h = opts.h;
     check_cracks(&spec.cracks)?;
     let mut mesh = match &spec.geometry {
+        Geometry::Box(_) if opts.mesh.is_some() => {
+            return Err(Error::model(
+                "reference.fem.mesh",
+                "applies to a gmsh case (its physical groups name the regions and boundaries); a box case takes `h`",
+            ))
+        }
+        Geometry::Mesh(_) if h.is_some() && opts.mesh.is_some() => {
+            return Err(Error::model(
+                "reference.fem.h",
+                "give either `h` (box cases) or `mesh` (gmsh cases), not both",
+            ))
+        }
+        Geometry::Mesh(g) if opts.mesh.is_some() => {
+            other_mesh(case, g, opts.mesh.as_deref().expect("checked"))?
+        }
         Geometry::Box(g) => {
             let finest = g
                 .regions
@@ -72,6 +157,19 @@ pub fn build_mesh(case: &Case, h: Option<f64>) -> Result<(FemMesh, usize)> {
             m
         }
     };
+    mesh.symmetry = spec.symmetry;
+    if spec.symmetry.is_symmetric() {
+        if let Some(p) = mesh.nodes.iter().find(|p| p.x < 0.0) {
+            return Err(Error::model(
+                "symmetry",
+                format!(
+                    "fem: {} model: a mesh node lies at r = x = {:e} < 0; the body must lie at x ≥ 0 (x is the radius)",
+                    spec.symmetry.name(),
+                    p.x
+                ),
+            ));
+        }
+    }
     let keys = crack_facets(&mesh, &spec.cracks)?;
     let added = split(&mut mesh, &keys);
     Ok((mesh, added))
@@ -96,10 +194,22 @@ pub struct FemModel {
 }
 
 impl FemModel {
-    /// Builds mesh, matrices and conditions of `case` (errors keyed as [`Error::Model`]).
+    /// Builds mesh, matrices and conditions of `case` on elements of size `h` (box cases) or
+    /// on its own mesh (errors keyed as [`Error::Model`]).
     pub fn build(case: &Case, h: Option<f64>) -> Result<FemModel> {
+        FemModel::build_with(
+            case,
+            &FemOptions {
+                h,
+                ..Default::default()
+            },
+        )
+    }
+
+    /// Builds mesh, matrices and conditions of `case` with the mesh settings of `opts`.
+    pub fn build_with(case: &Case, opts: &FemOptions) -> Result<FemModel> {
         let spec = &case.spec;
-        let (mesh, split_nodes) = build_mesh(case, h)?;
+        let (mesh, split_nodes) = build_mesh(case, opts)?;
         let mut system = assemble(&mesh, &spec.materials);
         let conditions = Conditions::build(&mesh, &spec.faces, spec.source.as_ref(), &mut system);
         let (cloud, recovery) = output_cloud(&mesh, &system, &spec.materials);
@@ -163,7 +273,7 @@ pub fn run_fem(
             Error::model("--dt", format!("fem: must be a positive step, got {dt}")),
         ));
     }
-    let model = FemModel::build(case, opts.h).map_err(|e| keyed(case, e))?;
+    let model = FemModel::build_with(case, opts).map_err(|e| keyed(case, e))?;
     let mut stepper = Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme);
     std::fs::create_dir_all(out).map_err(|error| Error::Io {
         path: out.to_path_buf(),

@@ -8,6 +8,7 @@
 
 use crate::math::{Point, Vector};
 use crate::mesh::ElementKind;
+use crate::symmetry::Symmetry;
 
 /// Most nodes of an element (the hexahedron).
 pub const MAX_NODES: usize = 8;
@@ -54,6 +55,38 @@ const HEX_RULE: [([f64; 3], f64); 8] = [
     ([G, G, G], 1.0),
     ([-G, G, G], 1.0),
 ];
+
+/// Gauss 3-point rule on [−1, 1], exact to degree 5.
+const LINE_RULE_3: [([f64; 3], f64); 3] = [
+    ([-0.774_596_669_241_483_4, 0.0, 0.0], 5.0 / 9.0),
+    ([0.0, 0.0, 0.0], 8.0 / 9.0),
+    ([0.774_596_669_241_483_4, 0.0, 0.0], 5.0 / 9.0),
+];
+const DA: f64 = 0.445_948_490_915_965; // Dunavant degree-4 6-point triangle rule
+const DB: f64 = 0.091_576_213_509_771;
+const WA: f64 = 0.223_381_589_678_011 / 2.0;
+const WB: f64 = 0.109_951_743_655_322 / 2.0;
+const TRI_RULE_4: [([f64; 3], f64); 6] = [
+    ([DA, DA, 0.0], WA),
+    ([1.0 - 2.0 * DA, DA, 0.0], WA),
+    ([DA, 1.0 - 2.0 * DA, 0.0], WA),
+    ([DB, DB, 0.0], WB),
+    ([1.0 - 2.0 * DB, DB, 0.0], WB),
+    ([DB, 1.0 - 2.0 * DB, 0.0], WB),
+];
+
+/// The rule for the integrals of a body with `symmetry`: [`quadrature`], except where the
+/// ring or shell weight raises the degree beyond it — spherical lines (4πr² N_a N_b, degree
+/// 4: Gauss 3-point) and axisymmetric triangles (2πr N_a N_b, degree 3: Dunavant's 6-point
+/// rule of degree 4). Exact integration keeps the O(1) relative quadrature error out of the
+/// cells at the axis or centre, where the weight varies from 0 across one cell.
+pub fn quadrature_for(kind: ElementKind, symmetry: Symmetry) -> &'static [([f64; 3], f64)] {
+    match (kind, symmetry) {
+        (ElementKind::Line, Symmetry::Spherical) => &LINE_RULE_3,
+        (ElementKind::Triangle, Symmetry::Axisymmetric) => &TRI_RULE_4,
+        _ => quadrature(kind),
+    }
+}
 
 /// Quadrature points (reference coordinates) and weights of an element kind, exact to degree 2.
 pub fn quadrature(kind: ElementKind) -> &'static [([f64; 3], f64)] {
@@ -230,5 +263,40 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The rules of symmetric bodies integrate every monomial up to their degree exactly
+    /// (line: x^k on [−1, 1], k ≤ 5; triangle: x^i y^j on the unit simplex, i + j ≤ 4, exact
+    /// value i! j!/(i + j + 2)!), to round-off (1e-14).
+    #[test]
+    fn symmetric_rules_are_exact_to_their_degree() {
+        let line = quadrature_for(ElementKind::Line, Symmetry::Spherical);
+        for k in 0..=5 {
+            let q: f64 = line.iter().map(|(x, w)| w * x[0].powi(k)).sum();
+            let exact = if k % 2 == 0 {
+                2.0 / (k + 1) as f64
+            } else {
+                0.0
+            };
+            assert!((q - exact).abs() < 1e-14, "x^{k}: {q} vs {exact}");
+        }
+        let fact = |n: i32| (1..=n).map(f64::from).product::<f64>();
+        let tri = quadrature_for(ElementKind::Triangle, Symmetry::Axisymmetric);
+        for i in 0..=4 {
+            for j in 0..=(4 - i) {
+                let q: f64 = tri
+                    .iter()
+                    .map(|(x, w)| w * x[0].powi(i) * x[1].powi(j))
+                    .sum();
+                let exact = fact(i) * fact(j) / fact(i + j + 2);
+                assert!((q - exact).abs() < 1e-14, "x^{i} y^{j}: {q} vs {exact}");
+            }
+        }
+        // planar bodies keep the degree-2 rules
+        assert_eq!(quadrature_for(ElementKind::Line, Symmetry::Planar).len(), 2);
+        assert_eq!(
+            quadrature_for(ElementKind::Quad, Symmetry::Axisymmetric).len(),
+            4
+        );
     }
 }

@@ -129,11 +129,7 @@ pub fn compare(
             0.0
         },
         l2_rel_line: if den > 0.0 { (num / den).sqrt() } else { 0.0 },
-        epsilon: if cmax > 0.0 {
-            (sq / n_kept.max(1) as f64).sqrt() / cmax
-        } else {
-            0.0
-        },
+        epsilon: epsilon((sq / n_kept.max(1) as f64).sqrt(), cmax),
         line_nodes: n_line,
         probe,
     }
@@ -148,6 +144,28 @@ pub struct FieldDifference {
     pub mean_abs: f64,
     /// Node of A where the largest difference occurs, m.
     pub at: Point,
+    /// Root mean square of θ_a − θ_b over the nodes of A compared, °C.
+    pub rms: f64,
+    /// max |θ_b| over the nodes of A compared (B interpolated there), °C.
+    pub reference_max_abs: f64,
+}
+
+impl FieldDifference {
+    /// Seed 001 eq 27 with B as the reference: ε = rms(θ_b − θ_a) / max |θ_b| (0 when B is
+    /// zero everywhere), dimensionless.
+    pub fn epsilon(&self) -> f64 {
+        epsilon(self.rms, self.reference_max_abs)
+    }
+}
+
+/// Seed 001 eq 27 from its two parts: ε = rms / max |T_ref| (0 when the reference is zero
+/// everywhere), dimensionless.
+pub fn epsilon(rms: f64, reference_max_abs: f64) -> f64 {
+    if reference_max_abs > 0.0 {
+        rms / reference_max_abs
+    } else {
+        0.0
+    }
 }
 
 /// Compares field A with a reference field B: B is interpolated at each node of A by a
@@ -162,26 +180,31 @@ pub fn field_difference(
     exclude: (&[Point], f64),
 ) -> FieldDifference {
     let index = PointIndex::new(b.0);
-    let per_node: Vec<f64> =
+    // (|θ_a − θ_b|, θ_b) per node of A, NaN where left out
+    let per_node: Vec<(f64, f64)> =
         a.0.par_iter()
             .zip(a.1.par_iter())
             .map(|(x, &ta)| {
                 if exclude.0.iter().any(|c| (x - c).norm() < exclude.1) {
-                    return f64::NAN;
+                    return (f64::NAN, f64::NAN);
                 }
-                (ta - interpolate(dim, &index, b, x, cracks)).abs()
+                let tb = interpolate(dim, &index, b, x, cracks);
+                ((ta - tb).abs(), tb)
             })
             .collect();
     let (imax, max_abs) = per_node
         .iter()
-        .copied()
+        .map(|p| p.0)
         .enumerate()
         .fold((0, 0.0), |m, (i, d)| if d > m.1 { (i, d) } else { m });
-    let kept: Vec<f64> = per_node.into_iter().filter(|d| !d.is_nan()).collect();
+    let kept: Vec<(f64, f64)> = per_node.into_iter().filter(|d| !d.0.is_nan()).collect();
+    let n = kept.len().max(1) as f64;
     FieldDifference {
         max_abs,
-        mean_abs: kept.iter().sum::<f64>() / kept.len().max(1) as f64,
+        mean_abs: kept.iter().map(|d| d.0).sum::<f64>() / n,
         at: a.0.get(imax).copied().unwrap_or_else(Point::origin),
+        rms: (kept.iter().map(|d| d.0 * d.0).sum::<f64>() / n).sqrt(),
+        reference_max_abs: kept.iter().map(|d| d.1.abs()).fold(0.0, f64::max),
     }
 }
 
@@ -235,4 +258,68 @@ fn fit_at(dim: usize, x: &Point, near: &[(usize, f64)], b: (&[Point], &[f64])) -
         }
     }
     b.1[j0]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analytic::Reference;
+
+    /// Seed 001 eq 27 by its definition: a field off the reference by the same d at every node
+    /// has rms d, so ε = d / max |T_ref| whatever the field; a difference at one node of N
+    /// gives rms d/√N. Both for `compare` (classical references) and `field_difference`
+    /// (runs: a linear reference field is interpolated exactly). Tolerance: round-off.
+    #[test]
+    fn epsilon_is_rms_over_reference_maximum() {
+        let n = 11;
+        let pos: Vec<Point> = (0..n)
+            .map(|i| Point::new(0.1 * i as f64, 0.0, 0.0))
+            .collect();
+        let cloud = Cloud {
+            dim: 1,
+            tau: 1.0,
+            pos: pos.clone(),
+            volume: vec![0.1; n],
+            spacing: vec![0.1; n],
+            horizon: vec![0.3; n],
+            material: vec![0; n],
+            region: vec![0; n],
+            n_body: n,
+            ..Default::default()
+        };
+        let spec = ReferenceSpec {
+            source: ReferenceSource::Analytic(Reference::AnnulusSteady {
+                inner_radius: 1.0,
+                outer_radius: 2.0,
+                inner: 0.0,
+                outer: 0.0,
+            }),
+            line_y: None,
+            line_x: None,
+            exclude_tips: 0.0,
+            probe: None,
+        };
+        // reference 300 + 200 x: max |T_ref| = 500 at x = 1
+        let reference: Vec<f64> = pos.iter().map(|p| 300.0 + 200.0 * p.x).collect();
+        let d = 2.5;
+        let shifted: Vec<f64> = reference.iter().map(|t| t + d).collect();
+        let c = compare(&cloud, &shifted, &reference, &spec, 1.0, &[]);
+        assert!((c.epsilon - d / 500.0).abs() < 1e-15, "{}", c.epsilon);
+        let mut one = reference.clone();
+        one[3] -= d;
+        let c = compare(&cloud, &one, &reference, &spec, 1.0, &[]);
+        let want = d / (n as f64).sqrt() / 500.0;
+        assert!((c.epsilon - want).abs() < 1e-15, "{} vs {want}", c.epsilon);
+        // a negative reference: the maximum is of |T_ref|
+        let negative: Vec<f64> = reference.iter().map(|t| -t).collect();
+        let moved: Vec<f64> = negative.iter().map(|t| t - d).collect();
+        let c = compare(&cloud, &moved, &negative, &spec, 1.0, &[]);
+        assert!((c.epsilon - d / 500.0).abs() < 1e-15);
+        // field to field: B is the reference, interpolated at A's nodes
+        let f = field_difference(1, (&pos, &shifted), (&pos, &reference), &[], (&[], 0.0));
+        assert!((f.rms - d).abs() < 1e-12, "{}", f.rms);
+        assert!((f.reference_max_abs - 500.0).abs() < 1e-12);
+        assert!((f.epsilon() - d / 500.0).abs() < 1e-14);
+        assert_eq!(epsilon(1.0, 0.0), 0.0);
+    }
 }
