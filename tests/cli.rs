@@ -166,7 +166,8 @@ fn bad_input_fails_with_one_clear_line() {
         ),
         (
             "negative latent heat",
-            SMALL.replace("[boundary.x_min]", &format!("{PHASE}[boundary.x_min]"))
+            SMALL
+                .replace("[boundary.x_min]", &format!("{PHASE}[boundary.x_min]"))
                 .replace("latent_heat = 3e5", "latent_heat = -3e5"),
             "material.steel.phase_change.latent_heat",
         ),
@@ -179,7 +180,10 @@ fn bad_input_fails_with_one_clear_line() {
         ),
         (
             "axisymmetric with thickness",
-            SMALL.replace("dimension = 2", "dimension = 2\nsymmetry = \"axisymmetric\""),
+            SMALL.replace(
+                "dimension = 2",
+                "dimension = 2\nsymmetry = \"axisymmetric\"",
+            ),
             "domain.thickness",
         ),
         (
@@ -192,7 +196,10 @@ fn bad_input_fails_with_one_clear_line() {
         (
             "layer at the axis",
             SMALL
-                .replace("dimension = 2", "dimension = 2\nsymmetry = \"axisymmetric\"")
+                .replace(
+                    "dimension = 2",
+                    "dimension = 2\nsymmetry = \"axisymmetric\"",
+                )
                 .replace("thickness = 0.1\n", ""),
             "symmetry",
         ),

@@ -121,6 +121,12 @@ pub fn build_mesh(case: &Case, opts: &FemOptions) -> Result<(FemMesh, usize)> {
     let spec = &case.spec;
     let h = opts.h;
     check_cracks(&spec.cracks)?;
+    if spec.materials.iter().any(|m| m.phase_change.is_some()) {
+        return Err(Error::model(
+            "material",
+            "the FEM reference is linear: phase change (material.<name>.phase_change) is not supported",
+        ));
+    }
     let mut mesh = match &spec.geometry {
         Geometry::Box(_) if opts.mesh.is_some() => {
             return Err(Error::model(
