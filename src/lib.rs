@@ -10,6 +10,7 @@
 
 pub mod analytic;
 pub mod bc;
+pub mod bench;
 pub mod case;
 pub mod cloud;
 pub mod consistency;
