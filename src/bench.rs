@@ -240,7 +240,7 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
     } else {
         (1 << 26, 15)
     };
-    say(&format!("triad, {} MB per array", triad_len * 8 >> 20));
+    say(&format!("triad, {} MB per array", (triad_len * 8) >> 20));
     let triad_1 = triad(&p1, triad_len, reps);
     let triad_n = triad(&pn, triad_len, reps);
     let configs: Vec<(String, usize, usize, f64)> = match opts.nodes {

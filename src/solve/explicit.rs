@@ -6,7 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::operator::Conductance;
+use crate::operator::{row_sum, Conductance, ROW_CHUNK};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -127,15 +127,25 @@ pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
 fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64]) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
-    out.par_iter_mut()
-        .with_min_len(1024)
+    out.par_chunks_mut(ROW_CHUNK)
         .enumerate()
-        .for_each(|(i, o)| {
-            *o = if driven[i] {
-                0.0
-            } else {
-                k.row_flow(i, theta) * inv[i]
-            };
+        .for_each(|(c, o)| {
+            let first = c * ROW_CHUNK;
+            let rows = first..first + o.len();
+            let off = &k.offsets[first..=rows.end];
+            for ((((o, w), &d), &inv), &ti) in o
+                .iter_mut()
+                .zip(off.windows(2))
+                .zip(&driven[rows.clone()])
+                .zip(&inv[rows.clone()])
+                .zip(&theta[rows])
+            {
+                *o = if d {
+                    0.0
+                } else {
+                    row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti) * inv
+                };
+            }
         });
     if model.boundary.has_loads() {
         model
@@ -147,6 +157,35 @@ fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64])
             }
         }
     }
+}
+
+/// One fused forward-Euler update of the body nodes, gather form: `next_i = θ_i + h·Σ_j K_ij
+/// (θ_j − θ_i)/(V_i ρc_i)` for free nodes, `θ_i` for driven ones (the boundary sets them
+/// after). The same bits as [`rates`] followed by `θ_i += h·rate_i`, in one pass.
+fn euler_fused(model: &Model, k: &Conductance, theta: &[f64], h: f64, next: &mut [f64]) {
+    let inv = &model.inv_heat_capacity;
+    let driven = &model.boundary.driven;
+    next.par_chunks_mut(ROW_CHUNK)
+        .enumerate()
+        .for_each(|(c, o)| {
+            let first = c * ROW_CHUNK;
+            let rows = first..first + o.len();
+            let off = &k.offsets[first..=rows.end];
+            for ((((o, w), &d), &inv), &ti) in o
+                .iter_mut()
+                .zip(off.windows(2))
+                .zip(&driven[rows.clone()])
+                .zip(&inv[rows.clone()])
+                .zip(&theta[rows])
+            {
+                *o = if d {
+                    ti
+                } else {
+                    let s = row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti);
+                    ti + h * (s * inv)
+                };
+            }
+        });
 }
 
 /// Explicit integrator state with preallocated buffers.
@@ -228,13 +267,24 @@ impl<'a> Explicit<'a> {
             | Integrator::Steady => {
                 panic!("implicit integrators run through solve::implicit, not Explicit")
             }
-            Integrator::Euler => {
+            Integrator::Euler if m.boundary.has_loads() => {
                 rates(m, k, theta, t, &mut self.k[0]);
                 theta[..nb]
-                    .par_iter_mut()
-                    .with_min_len(4096)
-                    .zip(&self.k[0])
-                    .for_each(|(y, k)| *y += h * k);
+                    .par_chunks_mut(ROW_CHUNK)
+                    .zip(self.k[0].par_chunks(ROW_CHUNK))
+                    .for_each(|(y, r)| {
+                        for (y, r) in y.iter_mut().zip(r) {
+                            *y += h * r;
+                        }
+                    });
+            }
+            Integrator::Euler => {
+                // the new body temperatures into k[0], then back into θ (the caller's slice)
+                euler_fused(m, k, theta, h, &mut self.k[0]);
+                theta[..nb]
+                    .par_chunks_mut(ROW_CHUNK)
+                    .zip(self.k[0].par_chunks(ROW_CHUNK))
+                    .for_each(|(y, n)| y.copy_from_slice(n));
             }
             Integrator::Rk4 => {
                 let [k1, k2, k3, k4] = &mut self.k;
@@ -299,10 +349,14 @@ impl<'a> Explicit<'a> {
 }
 
 fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
-    out.par_iter_mut()
-        .with_min_len(4096)
-        .enumerate()
-        .for_each(|(i, o)| *o = y[i] + a * k[i]);
+    out.par_chunks_mut(ROW_CHUNK)
+        .zip(y.par_chunks(ROW_CHUNK))
+        .zip(k.par_chunks(ROW_CHUNK))
+        .for_each(|((o, y), k)| {
+            for ((o, y), k) in o.iter_mut().zip(y).zip(k) {
+                *o = y + a * k;
+            }
+        });
 }
 
 fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
