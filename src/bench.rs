@@ -171,7 +171,6 @@ pub fn bond_bytes(model: &Model) -> usize {
     h.offsets.capacity() * 8
         + h.targets.capacity() * 4
         + h.beta.capacity() * 8
-        + h.eval_at.capacity() * 8
         + k.offsets.capacity() * 8
         + k.cols.capacity() * 4
         + k.vals.capacity() * 8

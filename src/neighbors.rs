@@ -2,7 +2,8 @@
 //!
 //! The relation is directed because horizons differ from node to node (seed 004 eqs 19–22:
 //! the α masks); each entry carries the partial-volume factor β_ij (formulation §2.3) and
-//! the distance at which the kernel profile is evaluated. Built once, in parallel.
+//! nothing else (the distance at which Algorithm 1 evaluates the kernel profile is recomputed
+//! by [`crate::kernel::Kernel::coverage`] where it is needed). Built once, in parallel.
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
@@ -19,8 +20,6 @@ pub struct Horizons {
     pub targets: Vec<NodeId>,
     /// Partial-volume factor β_ij ∈ (0, 1].
     pub beta: Vec<f64>,
-    /// Distance at which w(·/δ_i) is evaluated (Algorithm 1 lines 6 and 9), m.
-    pub eval_at: Vec<f64>,
 }
 
 /// Rows per parallel task of the search.
@@ -191,13 +190,14 @@ impl Horizons {
             ),
         };
         let nb = cloud.n_body;
-        let keep = |i: usize, j: usize| -> Option<(f64, f64)> {
+        // β of the bond i -> j, None when it is not a bond
+        let keep = |i: usize, j: usize| -> Option<f64> {
             if j == i || (i >= nb && j >= nb) {
                 return None;
             }
             let r = (cloud.pos[j] - cloud.pos[i]).norm();
-            let (beta, at) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
-            (beta > 0.0).then_some((beta, at))
+            let (beta, _) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
+            (beta > 0.0).then_some(beta)
         };
         // pass 1: sorted neighbour lists of each block of rows, and the row lengths
         let mut lens = vec![0usize; n];
@@ -233,40 +233,35 @@ impl Horizons {
             offsets,
             targets: vec![0; total],
             beta: vec![0.0; total],
-            eval_at: vec![0.0; total],
         };
-        // pass 2: copy each block into place with β and the evaluation distance
+        // pass 2: copy each block into place with β
         let starts: Vec<usize> = (0..blocks.len())
             .map(|c| h.offsets[c * SEARCH_CHUNK])
             .chain(std::iter::once(total))
             .collect();
         let mut t_rest = &mut h.targets[..];
         let mut b_rest = &mut h.beta[..];
-        let mut e_rest = &mut h.eval_at[..];
         let mut parts = Vec::with_capacity(blocks.len());
         for w in starts.windows(2) {
             let len = w[1] - w[0];
             let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(len);
             let (b, br) = std::mem::take(&mut b_rest).split_at_mut(len);
-            let (e, er) = std::mem::take(&mut e_rest).split_at_mut(len);
-            parts.push((t, b, e));
-            (t_rest, b_rest, e_rest) = (tr, br, er);
+            parts.push((t, b));
+            (t_rest, b_rest) = (tr, br);
         }
         let offsets = &h.offsets;
         blocks
             .into_par_iter()
             .zip(parts)
             .enumerate()
-            .for_each(|(c, (list, (t, b, e)))| {
+            .for_each(|(c, (list, (t, b)))| {
                 t.copy_from_slice(&list);
                 let first = c * SEARCH_CHUNK;
                 let last = (first + SEARCH_CHUNK).min(n);
+                let base = offsets[first];
                 for i in first..last {
-                    let base = offsets[first];
                     for k in offsets[i] - base..offsets[i + 1] - base {
-                        let (beta, at) = keep(i, t[k] as usize).expect("kept in pass 1");
-                        b[k] = beta;
-                        e[k] = at;
+                        b[k] = keep(i, t[k] as usize).expect("kept in pass 1");
                     }
                 }
             });

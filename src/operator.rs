@@ -47,7 +47,9 @@ pub fn directed_weights(
                 let j = horizons.targets[b] as usize;
                 let r = (cloud.pos[j] - cloud.pos[i]).norm();
                 let k = rule.combine(conductivity[i], conductivity[j]);
-                let c = kernel.micro(unit * k, r, horizons.eval_at[b], delta);
+                // where Algorithm 1 evaluates the profile (lines 6 and 9)
+                let (_, at) = kernel.coverage(r, delta, cloud.spacing[j]);
+                let c = kernel.micro(unit * k, r, at, delta);
                 // planar measures times the ring/shell pair factor (formulation §7)
                 let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
                 let shape = if sym.is_symmetric() {

@@ -393,7 +393,6 @@ fn neighbour_search_grid_equals_tree() {
     assert_eq!(a.offsets, b.offsets);
     assert_eq!(a.targets, b.targets);
     assert_eq!(a.beta, b.beta);
-    assert_eq!(a.eval_at, b.eval_at);
     assert_eq!(a.targets, model.horizons.targets);
 }
 
