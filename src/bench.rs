@@ -35,6 +35,8 @@ pub struct BenchOptions {
 pub struct StepRow {
     /// Configuration name, e.g. "2D m = 3".
     pub name: String,
+    /// Kernel: "CSR" (12 B streamed per bond) or "stencils" ([`crate::stencil`]).
+    pub kernel: &'static str,
     /// Body nodes.
     pub nodes: usize,
     /// Stored pair conductances (bond updates per step).
@@ -45,6 +47,8 @@ pub struct StepRow {
     pub step_n: f64,
     /// Bytes held by Horizons + Conductance per stored pair conductance, B.
     pub bytes_per_bond: f64,
+    /// Bytes held by the stencils per stored pair conductance (0 for CSR), B.
+    pub stencil_bytes_per_bond: f64,
 }
 
 /// Set-up times of a plate, s.
@@ -177,12 +181,19 @@ pub fn bond_bytes(model: &Model) -> usize {
         + k.diag.capacity() * 8
 }
 
-/// Median wall time of one Euler step of `model` on `pool` over `reps` steps, s.
-pub fn time_step(pool: &ThreadPool, model: &Model, reps: usize) -> f64 {
+/// Median wall time of one Euler step of `model` on `pool` over `reps` steps, s, through the
+/// stencils of K or the plain CSR rows; also the stencils' bytes (None when they are not used).
+pub fn time_step(
+    pool: &ThreadPool,
+    model: &Model,
+    reps: usize,
+    stencils: bool,
+) -> (f64, Option<usize>) {
     pool.install(|| {
         let dt = 0.5 * Integrator::Euler.stable_dt(model);
         let mut theta = model.theta0.clone();
         let mut st = Explicit::new(model, Integrator::Euler);
+        let used = st.set_stencils(stencils);
         st.step(&mut theta, 0.0, dt); // warm-up
         let times: Vec<f64> = (0..reps)
             .map(|s| {
@@ -192,7 +203,7 @@ pub fn time_step(pool: &ThreadPool, model: &Model, reps: usize) -> f64 {
             })
             .collect();
         std::hint::black_box(&theta);
-        median(times)
+        (median(times), used.then(|| st.stencil_bytes()))
     })
 }
 
@@ -291,16 +302,25 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
             model.cloud.n_body,
             model.conductance.nnz()
         ));
-        let step_1 = time_step(&p1, &model, step_reps);
-        let step_n = time_step(&pn, &model, step_reps);
-        steps.push(StepRow {
-            name,
-            nodes: model.cloud.n_body,
-            bonds: model.conductance.nnz(),
-            step_1,
-            step_n,
-            bytes_per_bond: bond_bytes(&model) as f64 / model.conductance.nnz() as f64,
-        });
+        let nnz = model.conductance.nnz() as f64;
+        for (kernel, on) in [("CSR", false), ("stencils", true)] {
+            let (step_1, used) = time_step(&p1, &model, step_reps, on);
+            let Some(held) = (if on { used } else { Some(0) }) else {
+                say(&format!("{name}: no stencils (rows do not repeat)"));
+                continue;
+            };
+            let (step_n, _) = time_step(&pn, &model, step_reps, on);
+            steps.push(StepRow {
+                name: name.clone(),
+                kernel,
+                nodes: model.cloud.n_body,
+                bonds: model.conductance.nnz(),
+                step_1,
+                step_n,
+                bytes_per_bond: bond_bytes(&model) as f64 / nnz,
+                stencil_bytes_per_bond: held as f64 / nnz,
+            });
+        }
     }
     Ok(BenchReport {
         threads: opts.threads,
@@ -328,14 +348,15 @@ impl BenchReport {
             lim(self.triad_n) / 1e9
         );
         s += &format!(
-            "| explicit Euler step | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, {n} threads | of the limit | B held per bond |\n"
+            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, {n} threads | of the 12 B/bond limit | B held per bond (+ stencils) |\n"
         );
-        s += "|---|---|---|---|---|---|---|---|---|\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|\n";
         for r in &self.steps {
             let rate = r.bonds as f64 / r.step_n;
             s += &format!(
-                "| {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} × 10⁹ | {:.0} % | {:.1} |\n",
+                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} × 10⁹ | {:.0} % | {:.1} (+ {:.2}) |\n",
                 r.name,
+                r.kernel,
                 r.nodes,
                 r.bonds,
                 r.step_1 * 1e3,
@@ -343,7 +364,8 @@ impl BenchReport {
                 r.step_1 / r.step_n,
                 rate / 1e9,
                 100.0 * rate / lim(self.triad_n),
-                r.bytes_per_bond
+                r.bytes_per_bond,
+                r.stencil_bytes_per_bond
             );
         }
         s += "\n| set-up | nodes | neighbour search | weights + assembly | search + assembly | whole Model::build |\n|---|---|---|---|---|---|\n";

@@ -33,6 +33,7 @@ pub mod report;
 pub mod run;
 pub mod solve;
 pub mod spatial;
+pub mod stencil;
 pub mod sweep;
 pub mod symmetry;
 

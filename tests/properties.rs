@@ -187,6 +187,21 @@ fn refined_dual_horizon(faces: &str) -> Model {
     model
 }
 
+/// One region of 128 × 64 cells on the 2 × 1 plate (Δ = 2⁻⁶, so lattice offsets are exact and
+/// rows repeat bit for bit: K compresses into stencils), with the given faces.
+fn uniform_plate(faces: &str) -> Model {
+    let mut spec = dual_horizon_case(faces, "lattice").spec;
+    let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
+        panic!("a box case")
+    };
+    g.regions.truncate(1);
+    g.regions[0].max[0] = 2.0;
+    g.regions[0].cells = [128, 64, 1];
+    let model = Model::build(&spec).unwrap();
+    assert!(model.cloud.n_body > 3 * peritherm::operator::ROW_CHUNK);
+    model
+}
+
 /// The parallel assembly gives, bit for bit, K_ij = w_ij + w_ji (w_ij alone, or w_ji alone, for
 /// one-way bonds) with sorted columns and row sums in column order, on a dual-horizon cloud
 /// with fictitious layers (one-way bonds at the horizon change).
@@ -328,23 +343,34 @@ fn serial_reference(model: &Model, integ: Integrator, dt: f64, steps: usize) -> 
     theta
 }
 
-/// Explicit runs on 1 and 2 threads give the same temperatures bit for bit, and agree with a
-/// plain serial implementation of the same scheme to 1e-12 relative (the fused kernel sums a
-/// row in another order than the serial product: round-off only), for Euler with and without
-/// loads and for RK4, with driven, fictitious and convective nodes.
+/// Explicit runs on 1 and 2 threads, through the plain CSR rows or the stencils of K, give
+/// the same temperatures bit for bit, and agree with a plain serial implementation of the same
+/// scheme to 1e-12 relative (the kernels sum a row in another order than the serial product:
+/// round-off only), for Euler with and without loads and for RK4, with driven, fictitious and
+/// convective nodes.
 #[test]
 fn explicit_runs_agree_serial_and_parallel() {
-    for (faces, integ) in [
-        (MIXED_FACES.to_string(), Integrator::Euler),
-        (format!("{MIXED_FACES}{CONVECTION_FACE}"), Integrator::Euler),
-        (MIXED_FACES.to_string(), Integrator::Rk4),
+    let mut stencils_seen = false;
+    for (faces, integ, lattice) in [
+        (MIXED_FACES.to_string(), Integrator::Euler, false),
+        (MIXED_FACES.to_string(), Integrator::Euler, true),
+        (
+            format!("{MIXED_FACES}{CONVECTION_FACE}"),
+            Integrator::Euler,
+            true,
+        ),
+        (MIXED_FACES.to_string(), Integrator::Rk4, false),
     ] {
-        let model = refined_dual_horizon(&faces);
+        let model = if lattice {
+            uniform_plate(&faces)
+        } else {
+            refined_dual_horizon(&faces)
+        };
         assert!(model.boundary.driven.iter().any(|&d| d));
         assert!(model.cloud.n_fictitious() > 0);
         let dt = choose_dt(&model, integ, None).unwrap();
         let steps = 60;
-        let run = |threads: usize| -> Vec<f64> {
+        let run = |threads: usize, stencils: bool| -> Vec<f64> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -352,14 +378,26 @@ fn explicit_runs_agree_serial_and_parallel() {
             pool.install(|| {
                 let mut theta = model.theta0.clone();
                 let mut st = Explicit::new(&model, integ);
+                let used = st.set_stencils(stencils);
+                assert!(!used || stencils);
                 for s in 0..steps {
                     st.step(&mut theta, s as f64 * dt, dt);
                 }
                 theta
             })
         };
-        let (one, two) = (run(1), run(2));
-        assert_eq!(one, two, "{integ:?}: 1 and 2 threads differ");
+        let one = run(1, false);
+        assert_eq!(one, run(2, false), "{integ:?}: 1 and 2 threads differ");
+        if integ == Integrator::Euler {
+            let mut st = Explicit::new(&model, integ);
+            stencils_seen |= st.set_stencils(true);
+            assert!(
+                !lattice || st.set_stencils(true),
+                "a lattice repeats its rows"
+            );
+            assert_eq!(one, run(1, true), "{integ:?}: stencils differ from CSR");
+            assert_eq!(one, run(2, true), "{integ:?}: stencils on 2 threads differ");
+        }
         let reference = serial_reference(&model, integ, dt, steps);
         let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let moved = (0..model.cloud.n_body)
@@ -376,6 +414,7 @@ fn explicit_runs_agree_serial_and_parallel() {
             );
         }
     }
+    assert!(stencils_seen, "the lattice plate must use stencils");
 }
 
 /// The bucket-grid search and the k-d tree give the same neighbour lists, bit for bit, on a
