@@ -60,7 +60,9 @@ pub struct SetupRow {
     pub nodes: usize,
     /// Neighbour search ([`Horizons::build`]), s.
     pub search: f64,
-    /// Directed weights and assembly of K ([`directed_weights`], [`Conductance::assemble`]), s.
+    /// Directed weights ([`directed_weights`]), s.
+    pub weights: f64,
+    /// Assembly of K ([`Conductance::assemble`]), s.
     pub assembly: f64,
     /// The whole [`Model::build`] (cloud, search, weights, assembly, boundary), s.
     pub build: f64,
@@ -207,8 +209,8 @@ pub fn time_step(
     })
 }
 
-/// Times the neighbour search and the assembly of a case's model separately, s.
-pub fn time_setup(pool: &ThreadPool, case: &Case) -> Result<(f64, f64)> {
+/// Times the neighbour search, the directed weights and the assembly of a case's model, s.
+pub fn time_setup(pool: &ThreadPool, case: &Case) -> Result<[f64; 3]> {
     let Geometry::Box(g) = &case.spec.geometry else {
         return Err(Error::model("bench", "set-up timing needs a box geometry"));
     };
@@ -217,8 +219,8 @@ pub fn time_setup(pool: &ThreadPool, case: &Case) -> Result<(f64, f64)> {
         let t = Instant::now();
         let horizons = Horizons::build(&cloud, &case.spec.kernel);
         let search = t.elapsed().as_secs_f64();
-        let t = Instant::now();
         let k: Vec<f64> = vec![case.spec.materials[0].conductivity; cloud.len()];
+        let t = Instant::now();
         let w = directed_weights(
             &cloud,
             &horizons,
@@ -226,10 +228,12 @@ pub fn time_setup(pool: &ThreadPool, case: &Case) -> Result<(f64, f64)> {
             &k,
             case.spec.bond_rule,
         );
+        let weights = t.elapsed().as_secs_f64();
+        let t = Instant::now();
         let kk = Conductance::assemble(&cloud, &horizons, &w);
         let assembly = t.elapsed().as_secs_f64();
         std::hint::black_box(&kk);
-        Ok((search, assembly))
+        Ok([search, weights, assembly])
     })
 }
 
@@ -277,11 +281,17 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         if setup.is_empty() {
             say(&format!("{name}: set-up"));
             let mut s = Vec::new();
+            let mut w = Vec::new();
             let mut a = Vec::new();
-            for _ in 0..if opts.quick { 1 } else { 3 } {
-                let (x, y) = time_setup(&pn, &case)?;
+            for _ in 0..if opts.quick || opts.nodes.is_some() {
+                1
+            } else {
+                3
+            } {
+                let [x, y, z] = time_setup(&pn, &case)?;
                 s.push(x);
-                a.push(y);
+                w.push(y);
+                a.push(z);
             }
             let t = Instant::now();
             let model = pn.install(|| Model::build(&case.spec))?;
@@ -290,6 +300,7 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
                 name: name.clone(),
                 nodes: model.cloud.n_body,
                 search: median(s),
+                weights: median(w),
                 assembly: median(a),
                 build,
             });
@@ -368,15 +379,16 @@ impl BenchReport {
                 r.stencil_bytes_per_bond
             );
         }
-        s += "\n| set-up | nodes | neighbour search | weights + assembly | search + assembly | whole Model::build |\n|---|---|---|---|---|---|\n";
+        s += "\n| set-up | nodes | neighbour search | directed weights | assembly of K | search + weights + assembly | whole Model::build |\n|---|---|---|---|---|---|---|\n";
         for r in &self.setup {
             s += &format!(
-                "| {} | {} | {:.2} s | {:.2} s | {:.2} s | {:.2} s |\n",
+                "| {} | {} | {:.2} s | {:.2} s | {:.2} s | {:.2} s | {:.2} s |\n",
                 r.name,
                 r.nodes,
                 r.search,
+                r.weights,
                 r.assembly,
-                r.search + r.assembly,
+                r.search + r.weights + r.assembly,
                 r.build
             );
         }
