@@ -11,9 +11,10 @@ use crate::error::{Error, Result};
 use crate::model::{Geometry, Model};
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
+use crate::run::run_case;
 use crate::solve::explicit::{Explicit, Integrator};
 use rayon::ThreadPool;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Bytes streamed per bond update by the bandwidth-bound model: a u32 column and an f64 K_ij.
@@ -28,6 +29,36 @@ pub struct BenchOptions {
     pub nodes: Option<usize>,
     /// Threads of the parallel columns (the 1-thread column always runs too).
     pub threads: usize,
+    /// Also run the explicit and implicit crack plate and thermal shock ([`CASES`], from the
+    /// repository root) with their outputs in this directory, and time them.
+    pub cases: Option<PathBuf>,
+}
+
+/// The explicit/implicit pairs of the README's "Implicit and steady solvers" comparison.
+pub const CASES: [&str; 4] = [
+    "cases/dh_crack_plate_k1_m1.toml",
+    "cases/dh_crack_plate_k1_m1_implicit.toml",
+    "cases/thermal_shock_k1_m1.toml",
+    "cases/thermal_shock_k1_m1_implicit.toml",
+];
+
+/// Time to solution of one case run by `peritherm bench --cases`.
+#[derive(Debug, Clone)]
+pub struct CaseRow {
+    /// Case file.
+    pub case: String,
+    /// Integrator name.
+    pub integrator: String,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Set-up (model, implicit elimination and symbolic factorisation), s.
+    pub setup: f64,
+    /// Integration with output writing, the reference excluded, s.
+    pub integration: f64,
+    /// max |θ_PD − θ_reference| at each output time, (s, °C).
+    pub errors: Vec<(f64, f64)>,
 }
 
 /// One row of the step table.
@@ -81,8 +112,38 @@ pub struct BenchReport {
     pub steps: Vec<StepRow>,
     /// Set-up rows.
     pub setup: Vec<SetupRow>,
+    /// Time-to-solution rows (with `--cases`).
+    pub cases: Vec<CaseRow>,
     /// Peak resident set of the process at the end, bytes (Linux VmHWM; None elsewhere).
     pub peak_rss: Option<u64>,
+}
+
+/// Runs [`CASES`] into `out/<case name>/` and times them.
+pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>> {
+    let mut rows = Vec::new();
+    for c in CASES {
+        let path = Path::new(c);
+        say(&format!("{c}: running"));
+        let case = Case::load(path)?;
+        let stem = path
+            .file_stem()
+            .map_or("case".into(), |s| s.to_string_lossy());
+        let s = run_case(&case, &out.join(stem.as_ref()), |_, _| {})?;
+        rows.push(CaseRow {
+            case: c.to_string(),
+            integrator: s.integrator.clone(),
+            steps: s.steps,
+            dt: s.dt,
+            setup: s.setup_seconds,
+            integration: s.wall_seconds,
+            errors: s
+                .reference
+                .iter()
+                .map(|r| (r.time, r.max_abs_diff))
+                .collect(),
+        });
+    }
+    Ok(rows)
 }
 
 fn pool(threads: usize) -> Result<ThreadPool> {
@@ -333,7 +394,12 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
             });
         }
     }
+    let cases = match &opts.cases {
+        Some(dir) => time_cases(dir, &mut say)?,
+        None => Vec::new(),
+    };
     Ok(BenchReport {
+        cases,
         threads: opts.threads,
         triad_1,
         triad_n,
@@ -391,6 +457,27 @@ impl BenchReport {
                 r.search + r.weights + r.assembly,
                 r.build
             );
+        }
+        if !self.cases.is_empty() {
+            s += "\n| case | integrator | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|\n";
+            for r in &self.cases {
+                let errors: Vec<String> = r
+                    .errors
+                    .iter()
+                    .map(|(t, e)| format!("{e:.3e} at {t} s"))
+                    .collect();
+                s += &format!(
+                    "| `{}` | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                    r.case,
+                    r.integrator,
+                    r.dt,
+                    r.steps,
+                    r.setup,
+                    r.integration,
+                    r.setup + r.integration,
+                    errors.join(", ")
+                );
+            }
         }
         if let Some(b) = self.peak_rss {
             s += &format!("\nPeak resident set: {:.2} GB\n", b as f64 / 1e9);

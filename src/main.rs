@@ -135,6 +135,10 @@ enum Command {
         /// Only the 2D m = 3 plate with about this many nodes (e.g. 1e7).
         #[arg(long, value_parser = parse_count)]
         nodes: Option<usize>,
+        /// Also run and time the explicit and implicit crack plate and thermal shock (from the
+        /// repository root; minutes), writing their outputs into this directory.
+        #[arg(long, value_name = "OUT_DIR")]
+        cases: Option<PathBuf>,
     },
     /// Validate a case and print its size and stable time step without running it.
     Check {
@@ -295,12 +299,17 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             against,
             exclude_tips,
         } => sweep(&cases, &vary, &out, against, exclude_tips),
-        Command::Bench { quick, nodes } => {
+        Command::Bench {
+            quick,
+            nodes,
+            cases,
+        } => {
             let threads = cli.threads.unwrap_or_else(rayon::current_num_threads);
             let opts = peritherm::bench::BenchOptions {
                 quick,
                 nodes,
                 threads,
+                cases,
             };
             let report = peritherm::bench::run(&opts, |line| eprintln!("bench: {line}"))?;
             say!("{}", report.markdown());
