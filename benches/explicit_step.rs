@@ -1,59 +1,50 @@
-//! Bond updates per second of one explicit step: 2D plate, δ = 3Δ (m = 3), 10⁶ nodes.
-//! Throughput is reported in stored pair conductances (bond updates) per second.
+//! Bond updates per second of one forward-Euler step on free plates (p = 1): 2D m = 3,
+//! 2D m = 6.5 and 3D m = 3, through the plain CSR rows and through the stencils of K.
+//! Throughput is reported in stored pair conductances (bond updates) per second. The sizes
+//! (about 10⁵ nodes) keep the bench short; `peritherm bench` measures 10⁶ nodes against the
+//! machine's memory bandwidth.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use peritherm::case::Case;
+use peritherm::bench::plate;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{Explicit, Integrator};
-use std::path::Path;
-
-fn plate(cells: usize) -> Model {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "plate"
-cells = [{cells}, {cells}]
-horizon = {{ factor = 3.0 }}
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-p = 1
-[initial]
-value = "sin(3*x)*cos(2*y)"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    Model::build(&Case::parse(&text, Path::new("bench.toml")).unwrap().spec).unwrap()
-}
 
 fn explicit_step(c: &mut Criterion) {
-    let cells: usize = std::env::var("PERITHERM_BENCH_CELLS")
+    let scale: f64 = std::env::var("PERITHERM_BENCH_SCALE")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(1000);
-    let model = plate(cells);
-    let dt = Integrator::Euler.stable_dt(&model) * 0.5;
+        .unwrap_or(1.0);
+    let side = |n: f64| (n * scale).round() as usize;
     let mut g = c.benchmark_group("explicit_step");
     g.sample_size(20);
-    g.throughput(Throughput::Elements(model.conductance.nnz() as u64));
-    let mut theta = model.theta0.clone();
-    let mut st = Explicit::new(&model, Integrator::Euler);
-    g.bench_function(format!("euler_2d_m3_{}_nodes", model.cloud.n_body), |b| {
-        b.iter(|| st.step(&mut theta, 0.0, dt))
-    });
-    let mut out = vec![0.0; model.cloud.n_body];
-    g.bench_function(
-        format!("bond_sum_2d_m3_{}_nodes", model.cloud.n_body),
-        |b| b.iter(|| model.conductance.apply(&model.theta0, &mut out)),
-    );
+    for (name, dim, cells, m) in [
+        ("2d_m3", 2, side(300.0), 3.0),
+        ("2d_m6.5", 2, side(200.0), 6.5),
+        ("3d_m3", 3, side(40.0), 3.0),
+    ] {
+        let case = plate(dim, cells, m).expect("the bench plate is valid");
+        let model = Model::build(&case.spec).expect("the bench plate builds");
+        let dt = Integrator::Euler.stable_dt(&model) * 0.5;
+        g.throughput(Throughput::Elements(model.conductance.nnz() as u64));
+        for (kernel, on) in [("csr", false), ("stencils", true)] {
+            let mut theta = model.theta0.clone();
+            let mut st = Explicit::new(&model, Integrator::Euler);
+            if st.set_stencils(on) != on {
+                continue;
+            }
+            g.bench_function(
+                format!("euler_{name}_{kernel}_{}_nodes", model.cloud.n_body),
+                |b| b.iter(|| st.step(&mut theta, 0.0, dt)),
+            );
+        }
+        if name == "2d_m3" {
+            let mut out = vec![0.0; model.cloud.n_body];
+            g.bench_function(
+                format!("bond_sum_{name}_{}_nodes", model.cloud.n_body),
+                |b| b.iter(|| model.conductance.apply(&model.theta0, &mut out)),
+            );
+        }
+    }
     g.finish();
 }
 

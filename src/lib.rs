@@ -10,6 +10,7 @@
 
 pub mod analytic;
 pub mod bc;
+pub mod bench;
 pub mod case;
 pub mod cloud;
 pub mod consistency;
@@ -32,6 +33,7 @@ pub mod report;
 pub mod run;
 pub mod solve;
 pub mod spatial;
+pub mod stencil;
 pub mod sweep;
 pub mod symmetry;
 

@@ -126,6 +126,20 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Measure the explicit step against the memory bandwidth (STREAM-like triad), the
+    /// neighbour search and assembly, and the bytes per bond; print Markdown tables.
+    Bench {
+        /// Small problems and few repetitions (a smoke run, not a measurement).
+        #[arg(long)]
+        quick: bool,
+        /// Only the 2D m = 3 plate with about this many nodes (e.g. 1e7).
+        #[arg(long, value_parser = parse_count)]
+        nodes: Option<usize>,
+        /// Also run and time the explicit and implicit crack plate and thermal shock (from the
+        /// repository root; minutes), writing their outputs into this directory.
+        #[arg(long, value_name = "OUT_DIR")]
+        cases: Option<PathBuf>,
+    },
     /// Validate a case and print its size and stable time step without running it.
     Check {
         /// The case file (TOML).
@@ -142,6 +156,16 @@ enum FemScheme {
     CrankNicolson,
     /// The steady state at every output time.
     Steady,
+}
+
+/// Parses a count such as `1000000` or `1e7`.
+fn parse_count(s: &str) -> Result<usize, String> {
+    let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if v.is_finite() && v >= 1.0 {
+        Ok(v.round() as usize)
+    } else {
+        Err(format!("`{s}` is not a positive count"))
+    }
 }
 
 /// Prints a line to stdout; a closed pipe (e.g. `| head`) ends the output quietly.
@@ -280,6 +304,22 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             against,
             exclude_tips,
         } => sweep(&cases, &vary, &out, against, exclude_tips),
+        Command::Bench {
+            quick,
+            nodes,
+            cases,
+        } => {
+            let threads = cli.threads.unwrap_or_else(rayon::current_num_threads);
+            let opts = peritherm::bench::BenchOptions {
+                quick,
+                nodes,
+                threads,
+                cases,
+            };
+            let report = peritherm::bench::run(&opts, |line| eprintln!("bench: {line}"))?;
+            say!("{}", report.markdown());
+            Ok(())
+        }
         Command::Check { case } => {
             let case = Case::load(&case)?;
             let model =

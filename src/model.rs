@@ -213,6 +213,9 @@ fn pair_cuts(
     k: &Conductance,
     later: &[(usize, f64, f64)],
 ) -> Vec<PairCut> {
+    if later.is_empty() {
+        return Vec::new();
+    }
     let mut rows = vec![0usize; horizons.n_bonds()];
     for i in 0..horizons.len() {
         for b in horizons.row(i) {

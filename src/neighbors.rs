@@ -2,7 +2,8 @@
 //!
 //! The relation is directed because horizons differ from node to node (seed 004 eqs 19–22:
 //! the α masks); each entry carries the partial-volume factor β_ij (formulation §2.3) and
-//! the distance at which the kernel profile is evaluated. Built once, in parallel.
+//! nothing else (the distance at which Algorithm 1 evaluates the kernel profile is recomputed
+//! by [`crate::kernel::Kernel::coverage`] where it is needed). Built once, in parallel.
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
@@ -19,14 +20,160 @@ pub struct Horizons {
     pub targets: Vec<NodeId>,
     /// Partial-volume factor β_ij ∈ (0, 1].
     pub beta: Vec<f64>,
-    /// Distance at which w(·/δ_i) is evaluated (Algorithm 1 lines 6 and 9), m.
-    pub eval_at: Vec<f64>,
+}
+
+/// Rows per parallel task of the search.
+const SEARCH_CHUNK: usize = 2048;
+
+/// A uniform bucket grid over the cloud's bounding box (cells of half the largest reach),
+/// nodes listed cell by cell in increasing index.
+struct Grid {
+    lo: [f64; 3],
+    inv: f64,
+    dims: [usize; 3],
+    start: Vec<u32>,
+    items: Vec<NodeId>,
+}
+
+impl Grid {
+    /// The grid for `pts`, or None when it would not pay: reaches that vary more than 4×
+    /// (a refined mesh) or more cells than 8 per node.
+    fn new(pts: &[[f64; 3]], reach: &[f64]) -> Option<Grid> {
+        let rmax = reach.iter().cloned().fold(0.0, f64::max);
+        let rmin = reach.iter().cloned().fold(f64::INFINITY, f64::min);
+        if !(rmin > 0.0 && rmax <= 4.0 * rmin) || pts.len() >= u32::MAX as usize {
+            return None;
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in pts {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        let cell = 0.5 * rmax;
+        let inv = 1.0 / cell;
+        let mut dims = [1usize; 3];
+        let mut cells = 1.0;
+        for a in 0..3 {
+            let d = ((hi[a] - lo[a]) * inv).floor() + 1.0;
+            cells *= d;
+            dims[a] = d as usize;
+        }
+        if cells.is_nan() || cells > 8.0 * pts.len() as f64 + 1024.0 {
+            return None;
+        }
+        let mut g = Grid {
+            lo,
+            inv,
+            dims,
+            start: Vec::new(),
+            items: vec![0; pts.len()],
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let of: Vec<u32> = pts.iter().map(|p| g.cell_of(p) as u32).collect();
+        let mut start = vec![0u32; ncell + 1];
+        for &c in &of {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..ncell {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        for (i, &c) in of.iter().enumerate() {
+            g.items[fill[c as usize] as usize] = i as NodeId;
+            fill[c as usize] += 1;
+        }
+        g.start = start;
+        Some(g)
+    }
+
+    fn coord(&self, x: f64, a: usize) -> usize {
+        (((x - self.lo[a]) * self.inv).floor().max(0.0) as usize).min(self.dims[a] - 1)
+    }
+
+    fn cell_of(&self, p: &[f64; 3]) -> usize {
+        (self.coord(p[2], 2) * self.dims[1] + self.coord(p[1], 1)) * self.dims[0]
+            + self.coord(p[0], 0)
+    }
+
+    /// Pushes every node q with |q − p|² ≤ r2 onto `out` (unsorted).
+    fn within(&self, pts: &[[f64; 3]], p: &[f64; 3], r2: f64, out: &mut Vec<NodeId>) {
+        // a slightly larger box: |q − p|² ≤ r2 may hold a hair outside p ± √r2 by rounding
+        let r = r2.sqrt() * (1.0 + 1e-9);
+        let lo: [usize; 3] = std::array::from_fn(|a| self.coord(p[a] - r, a));
+        let hi: [usize; 3] = std::array::from_fn(|a| self.coord(p[a] + r, a));
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                let (a, b) = (
+                    self.start[row + lo[0]] as usize,
+                    self.start[row + hi[0] + 1] as usize,
+                );
+                for &j in &self.items[a..b] {
+                    let q = &pts[j as usize];
+                    let (dx, dy, dz) = (q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+                    if dx * dx + dy * dy + dz * dz <= r2 {
+                        out.push(j);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Fixed-radius search: the bucket grid for near-uniform clouds, else a k-d tree (kiddo).
+enum Finder {
+    Grid(Grid),
+    Tree(ImmutableKdTree<f64, 3>),
+}
+
+impl Finder {
+    fn within(&self, pts: &[[f64; 3]], i: usize, r2: f64, out: &mut Vec<NodeId>) {
+        match self {
+            Finder::Grid(g) => g.within(pts, &pts[i], r2, out),
+            Finder::Tree(t) => out.extend(
+                t.query(&pts[i])
+                    .within::<SquaredEuclidean<f64>>(r2)
+                    .unsorted()
+                    .execute()
+                    .into_iter()
+                    .map(|it| it.item as NodeId),
+            ),
+        }
+    }
+}
+
+/// Search radius of every node: its horizon plus the partial-volume band of the coarsest spacing.
+fn reaches(cloud: &Cloud, kernel: &Kernel) -> Vec<f64> {
+    let dmax = cloud.spacing.iter().cloned().fold(0.0, f64::max);
+    cloud
+        .horizon
+        .iter()
+        .map(|&d| kernel.reach(d, dmax))
+        .collect()
 }
 
 impl Horizons {
-    /// Finds, for every node, the neighbours inside its horizon (kiddo fixed-radius search,
-    /// radius δ_i plus the partial-volume band). Bonds between two fictitious nodes are dropped.
+    /// Finds, for every node, the neighbours inside its horizon (fixed-radius search, radius
+    /// δ_i plus the partial-volume band). Bonds between two fictitious nodes are dropped.
+    /// Two parallel passes over blocks of rows: the sorted neighbours of each block, then β
+    /// and the evaluation distance written straight into the final arrays.
     pub fn build(cloud: &Cloud, kernel: &Kernel) -> Self {
+        Self::build_with(cloud, kernel, true)
+    }
+
+    /// True when [`Horizons::build`] searches with the bucket grid (near-uniform reaches),
+    /// false when it uses the k-d tree.
+    pub fn grid_applies(cloud: &Cloud, kernel: &Kernel) -> bool {
+        let pts: Vec<[f64; 3]> = cloud.pos.iter().map(|p| [p.x, p.y, p.z]).collect();
+        !pts.is_empty() && Grid::new(&pts, &reaches(cloud, kernel)).is_some()
+    }
+
+    /// [`Horizons::build`] with the bucket grid allowed or not (the k-d tree always works;
+    /// both give the same lists).
+    pub fn build_with(cloud: &Cloud, kernel: &Kernel, grid: bool) -> Self {
         let pts: Vec<[f64; 3]> = cloud.pos.iter().map(|p| [p.x, p.y, p.z]).collect();
         let n = pts.len();
         if n == 0 {
@@ -35,53 +182,89 @@ impl Horizons {
                 ..Default::default()
             };
         }
-        let tree: ImmutableKdTree<f64, 3> =
-            ImmutableKdTree::new_from_slice(&pts).expect("a non-empty cloud builds a k-d tree");
-        let dmax = cloud.spacing.iter().cloned().fold(0.0, f64::max);
-        let rows: Vec<Vec<(NodeId, f64, f64)>> = (0..n)
-            .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let delta = cloud.horizon[i];
-                let reach = kernel.reach(delta, dmax);
-                let found = tree
-                    .query(&pts[i])
-                    .within::<SquaredEuclidean<f64>>(reach * reach * (1.0 + 1e-12))
-                    .unsorted()
-                    .execute();
-                let mut row: Vec<(NodeId, f64, f64)> = Vec::with_capacity(found.len());
-                for it in found {
-                    let j = it.item as usize;
-                    if j == i || (i >= cloud.n_body && j >= cloud.n_body) {
-                        continue;
-                    }
-                    let r = (cloud.pos[j] - cloud.pos[i]).norm();
-                    let (beta, at) = kernel.coverage(r, delta, cloud.spacing[j]);
-                    if beta > 0.0 {
-                        row.push((j as NodeId, beta, at));
-                    }
+        let reach = reaches(cloud, kernel);
+        let finder = match grid.then(|| Grid::new(&pts, &reach)).flatten() {
+            Some(g) => Finder::Grid(g),
+            None => Finder::Tree(
+                ImmutableKdTree::new_from_slice(&pts).expect("a non-empty cloud builds a k-d tree"),
+            ),
+        };
+        let nb = cloud.n_body;
+        // β of the bond i -> j, None when it is not a bond
+        let keep = |i: usize, j: usize| -> Option<f64> {
+            if j == i || (i >= nb && j >= nb) {
+                return None;
+            }
+            let r = (cloud.pos[j] - cloud.pos[i]).norm();
+            let (beta, _) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
+            (beta > 0.0).then_some(beta)
+        };
+        // pass 1: sorted neighbour lists of each block of rows, and the row lengths
+        let mut lens = vec![0usize; n];
+        let blocks: Vec<Vec<NodeId>> = lens
+            .par_chunks_mut(SEARCH_CHUNK)
+            .enumerate()
+            .map(|(c, lens)| {
+                let first = c * SEARCH_CHUNK;
+                let mut list = Vec::new();
+                let mut found = Vec::new();
+                for (r, len) in lens.iter_mut().enumerate() {
+                    let i = first + r;
+                    found.clear();
+                    finder.within(&pts, i, reach[i] * reach[i] * (1.0 + 1e-12), &mut found);
+                    found.retain(|&j| keep(i, j as usize).is_some());
+                    found.sort_unstable();
+                    *len = found.len();
+                    list.extend_from_slice(&found);
                 }
-                row.sort_unstable_by_key(|e| e.0);
-                row
+                list.shrink_to_fit();
+                list
             })
             .collect();
-        let mut h = Horizons {
-            offsets: Vec::with_capacity(n + 1),
-            ..Default::default()
-        };
-        let total: usize = rows.iter().map(Vec::len).sum();
-        h.targets.reserve(total);
-        h.beta.reserve(total);
-        h.eval_at.reserve(total);
-        h.offsets.push(0);
-        for row in rows {
-            for (j, b, at) in row {
-                h.targets.push(j);
-                h.beta.push(b);
-                h.eval_at.push(at);
-            }
-            h.offsets.push(h.targets.len());
+        drop(finder);
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0usize);
+        for (i, len) in lens.iter().enumerate() {
+            offsets.push(offsets[i] + len);
         }
+        drop(lens);
+        let total = offsets[n];
+        let mut h = Horizons {
+            offsets,
+            targets: vec![0; total],
+            beta: vec![0.0; total],
+        };
+        // pass 2: copy each block into place with β
+        let starts: Vec<usize> = (0..blocks.len())
+            .map(|c| h.offsets[c * SEARCH_CHUNK])
+            .chain(std::iter::once(total))
+            .collect();
+        let mut t_rest = &mut h.targets[..];
+        let mut b_rest = &mut h.beta[..];
+        let mut parts = Vec::with_capacity(blocks.len());
+        for w in starts.windows(2) {
+            let len = w[1] - w[0];
+            let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(len);
+            let (b, br) = std::mem::take(&mut b_rest).split_at_mut(len);
+            parts.push((t, b));
+            (t_rest, b_rest) = (tr, br);
+        }
+        let offsets = &h.offsets;
+        blocks
+            .into_par_iter()
+            .zip(parts)
+            .enumerate()
+            .for_each(|(c, (list, (t, b)))| {
+                t.copy_from_slice(&list);
+                let first = c * SEARCH_CHUNK;
+                let last = (first + SEARCH_CHUNK).min(n);
+                let base = offsets[first];
+                for i in first..last {
+                    for k in offsets[i] - base..offsets[i + 1] - base {
+                        b[k] = keep(i, t[k] as usize).expect("kept in pass 1");
+                    }
+                }
+            });
         h
     }
 

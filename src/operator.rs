@@ -47,7 +47,9 @@ pub fn directed_weights(
                 let j = horizons.targets[b] as usize;
                 let r = (cloud.pos[j] - cloud.pos[i]).norm();
                 let k = rule.combine(conductivity[i], conductivity[j]);
-                let c = kernel.micro(unit * k, r, horizons.eval_at[b], delta);
+                // where Algorithm 1 evaluates the profile (lines 6 and 9)
+                let (_, at) = kernel.coverage(r, delta, cloud.spacing[j]);
+                let c = kernel.micro(unit * k, r, at, delta);
                 // planar measures times the ring/shell pair factor (formulation §7)
                 let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
                 let shape = if sym.is_symmetric() {
@@ -74,80 +76,166 @@ fn unit_normalisations(cloud: &Cloud, kernel: &Kernel) -> Vec<f64> {
         .collect()
 }
 
+/// Rows per parallel task of the bond sums (the order inside a row never depends on it).
+pub const ROW_CHUNK: usize = 2048;
+
+/// Σ_k v_k (θ[c_k] − θ_i) over one row of K, W: four partial sums over the entries 4q + r,
+/// added as (s0 + s1) + (s2 + s3) after the remainder joined s0. The order is fixed by the row
+/// alone, so every thread count gives the same bits (formulation §2, gather form).
+#[inline(always)]
+pub fn row_sum(cols: &[NodeId], vals: &[f64], theta: &[f64], ti: f64) -> f64 {
+    let n = cols.len().min(vals.len());
+    let (cols, vals) = (&cols[..n], &vals[..n]);
+    let mut a = [0.0f64; 4];
+    let mut cc = cols.chunks_exact(4);
+    let mut vc = vals.chunks_exact(4);
+    for (c, v) in (&mut cc).zip(&mut vc) {
+        a[0] += v[0] * (theta[c[0] as usize] - ti);
+        a[1] += v[1] * (theta[c[1] as usize] - ti);
+        a[2] += v[2] * (theta[c[2] as usize] - ti);
+        a[3] += v[3] * (theta[c[3] as usize] - ti);
+    }
+    for (c, v) in cc.remainder().iter().zip(vc.remainder()) {
+        a[0] += v * (theta[*c as usize] - ti);
+    }
+    (a[0] + a[1]) + (a[2] + a[3])
+}
+
+/// Splits a per-row array (`data[i]`, rows `0..data.len()`) into tasks of [`ROW_CHUNK`] rows,
+/// each tagged with its first row.
+fn row_tasks<T: Send>(data: &mut [T]) -> impl IndexedParallelIterator<Item = (usize, &mut [T])> {
+    data.par_chunks_mut(ROW_CHUNK)
+        .enumerate()
+        .map(|(c, s)| (c * ROW_CHUNK, s))
+}
+
+/// Splits `per_entry` (one item per CSR entry, rows delimited by `offsets`) into one slice per
+/// block of rows `bounds[b]..bounds[b + 1]`.
+fn split_blocks<'a, T>(
+    offsets: &[usize],
+    bounds: &[usize],
+    per_entry: &'a mut [T],
+) -> Vec<&'a mut [T]> {
+    let mut out = Vec::with_capacity(bounds.len().saturating_sub(1));
+    let mut rest = per_entry;
+    for w in bounds.windows(2) {
+        let (a, b) = std::mem::take(&mut rest).split_at_mut(offsets[w[1]] - offsets[w[0]]);
+        out.push(a);
+        rest = b;
+    }
+    out
+}
+
+/// Position of `i` in the sorted list `row`: tries `guess` first (on a lattice the reverse bond
+/// of the p-th of n entries is the (n − 1 − p)-th), then a binary search.
+#[inline]
+fn find(row: &[NodeId], i: NodeId, guess: usize) -> Option<usize> {
+    if row.get(guess) == Some(&i) {
+        Some(guess)
+    } else {
+        row.binary_search(&i).ok()
+    }
+}
+
 impl Conductance {
-    /// Assembles K from the directed bonds and their half-conductances (in parallel).
+    /// Assembles K from the directed bonds and their half-conductances (in parallel, no
+    /// transpose): K_ij = w_ij + w_ji with w_ji found in row j, plus the bonds j → i whose
+    /// reverse does not exist (at horizon changes), collected separately.
     pub fn assemble(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Self {
         let n = horizons.len();
         let nb = cloud.n_body;
-        // transpose: for each node j, the bonds i -> j
-        let mut in_off = vec![0usize; n + 1];
-        for &j in &horizons.targets {
-            in_off[j as usize + 1] += 1;
-        }
-        for j in 0..n {
-            in_off[j + 1] += in_off[j];
-        }
-        let mut fill = in_off.clone();
-        let mut in_src = vec![0 as NodeId; horizons.n_bonds()];
-        let mut in_w = vec![0.0; horizons.n_bonds()];
-        for i in 0..n {
-            for b in horizons.row(i) {
-                let j = horizons.targets[b] as usize;
-                in_src[fill[j]] = i as NodeId;
-                in_w[fill[j]] = weights[b];
-                fill[j] += 1;
-            }
-        }
-        // merge out- and in-lists of each body row (both sorted by neighbour index)
-        let rows: Vec<(Vec<NodeId>, Vec<f64>)> = (0..nb)
+        let targets = &horizons.targets;
+        let row = |i: usize| &targets[horizons.row(i)];
+        // bonds j -> i into a body node i that has no bond i -> j: (i, j, w_ji)
+        let mut lone: Vec<(NodeId, NodeId, f64)> = (0..n)
             .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let out = horizons.row(i);
-                let (ot, ow) = (&horizons.targets[out.clone()], &weights[out]);
-                let (it, iw) = (
-                    &in_src[in_off[i]..in_off[i + 1]],
-                    &in_w[in_off[i]..in_off[i + 1]],
-                );
-                let mut cols = Vec::with_capacity(ot.len().max(it.len()));
-                let mut vals = Vec::with_capacity(cols.capacity());
-                let (mut a, mut b) = (0, 0);
-                while a < ot.len() || b < it.len() {
-                    let ja = ot.get(a).copied().unwrap_or(NodeId::MAX);
-                    let jb = it.get(b).copied().unwrap_or(NodeId::MAX);
-                    if ja == jb {
-                        cols.push(ja);
-                        vals.push(ow[a] + iw[b]);
-                        a += 1;
-                        b += 1;
-                    } else if ja < jb {
-                        cols.push(ja);
-                        vals.push(ow[a]);
-                        a += 1;
-                    } else {
-                        cols.push(jb);
-                        vals.push(iw[b]);
-                        b += 1;
+            .with_min_len(1024)
+            .flat_map_iter(|j| {
+                let out = row(j);
+                let start = horizons.offsets[j];
+                out.iter().enumerate().filter_map(move |(p, &i)| {
+                    let iu = i as usize;
+                    if iu >= nb {
+                        return None;
                     }
-                }
-                (cols, vals)
+                    let back = row(iu);
+                    let guess = back.len().wrapping_sub(p + 1);
+                    match find(back, j as NodeId, guess.min(back.len())) {
+                        Some(_) => None,
+                        None => Some((i, j as NodeId, weights[start + p])),
+                    }
+                })
             })
             .collect();
-        let mut k = Conductance {
-            offsets: Vec::with_capacity(nb + 1),
-            ..Default::default()
-        };
-        k.offsets.push(0);
-        let nnz: usize = rows.iter().map(|r| r.0.len()).sum();
-        k.cols.reserve(nnz);
-        k.vals.reserve(nnz);
-        for (c, v) in rows {
-            k.diag.push(v.iter().sum());
-            k.cols.extend_from_slice(&c);
-            k.vals.extend_from_slice(&v);
-            k.offsets.push(k.cols.len());
+        lone.par_sort_unstable_by_key(|e| (e.0, e.1));
+        let mut lone_off = vec![0usize; nb + 1];
+        for e in &lone {
+            lone_off[e.0 as usize + 1] += 1;
         }
-        k
+        for i in 0..nb {
+            lone_off[i + 1] += lone_off[i];
+        }
+        let mut offsets = Vec::with_capacity(nb + 1);
+        offsets.push(0usize);
+        for i in 0..nb {
+            let len = horizons.row(i).len() + lone_off[i + 1] - lone_off[i];
+            offsets.push(offsets[i] + len);
+        }
+        let nnz = offsets[nb];
+        let mut cols = vec![0 as NodeId; nnz];
+        let mut vals = vec![0.0; nnz];
+        let mut diag = vec![0.0; nb];
+        let bounds: Vec<usize> = (0..nb)
+            .step_by(ROW_CHUNK)
+            .chain(std::iter::once(nb))
+            .collect();
+        let cb = split_blocks(&offsets, &bounds, &mut cols);
+        let vb = split_blocks(&offsets, &bounds, &mut vals);
+        cb.into_par_iter()
+            .zip(vb)
+            .zip(diag.par_chunks_mut(ROW_CHUNK))
+            .enumerate()
+            .for_each(|(blk, ((cs, vs), ds))| {
+                let first = bounds[blk];
+                let mut e = 0;
+                for (r, d) in ds.iter_mut().enumerate() {
+                    let i = first + r;
+                    let out = row(i);
+                    let len = out.len();
+                    let ow = &weights[horizons.row(i)];
+                    let extra = &lone[lone_off[i]..lone_off[i + 1]];
+                    let start = e;
+                    let (mut a, mut b) = (0, 0);
+                    while a < len || b < extra.len() {
+                        let ja = out.get(a).copied().unwrap_or(NodeId::MAX);
+                        let jb = extra.get(b).map_or(NodeId::MAX, |x| x.1);
+                        if ja < jb {
+                            let ju = ja as usize;
+                            let back = row(ju);
+                            let guess = back.len().wrapping_sub(a + 1);
+                            let w = match find(back, i as NodeId, guess.min(back.len())) {
+                                Some(q) => ow[a] + weights[horizons.offsets[ju] + q],
+                                None => ow[a],
+                            };
+                            cs[e] = ja;
+                            vs[e] = w;
+                            a += 1;
+                        } else {
+                            cs[e] = jb;
+                            vs[e] = extra[b].2;
+                            b += 1;
+                        }
+                        e += 1;
+                    }
+                    *d = vs[start..e].iter().sum();
+                }
+            });
+        Conductance {
+            offsets,
+            cols,
+            vals,
+            diag,
+        }
     }
 
     /// Number of rows (body nodes).
@@ -163,21 +251,17 @@ impl Conductance {
     /// Heat flow into node i, Σ_j K_ij (θ_j − θ_i), W.
     #[inline]
     pub fn row_flow(&self, i: usize, theta: &[f64]) -> f64 {
-        let ti = theta[i];
         let row = self.offsets[i]..self.offsets[i + 1];
-        let mut s = 0.0;
-        for (&j, &k) in self.cols[row.clone()].iter().zip(&self.vals[row]) {
-            s += k * (theta[j as usize] - ti);
-        }
-        s
+        row_sum(&self.cols[row.clone()], &self.vals[row], theta, theta[i])
     }
 
     /// Writes the bond heat flow of every body node into `out` (gather form, in parallel), W.
     pub fn apply(&self, theta: &[f64], out: &mut [f64]) {
-        out.par_iter_mut()
-            .with_min_len(1024)
-            .enumerate()
-            .for_each(|(i, o)| *o = self.row_flow(i, theta));
+        row_tasks(out).for_each(|(first, o)| {
+            for (r, o) in o.iter_mut().enumerate() {
+                *o = self.row_flow(first + r, theta);
+            }
+        });
     }
 
     /// Serial version of [`Conductance::apply`], for the serial == parallel property.

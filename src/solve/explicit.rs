@@ -6,7 +6,8 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::operator::Conductance;
+use crate::operator::{row_sum, Conductance, ROW_CHUNK};
+use crate::stencil::Stencils;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -125,18 +126,46 @@ pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
 }
 
 fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64]) {
+    rates_with(model, k, None, theta, t, out);
+}
+
+/// [`rates`] through the stencils of K when there are some (the same bits).
+fn rates_with(
+    model: &Model,
+    k: &Conductance,
+    stencils: Option<&Stencils>,
+    theta: &[f64],
+    t: f64,
+    out: &mut [f64],
+) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
-    out.par_iter_mut()
-        .with_min_len(1024)
-        .enumerate()
-        .for_each(|(i, o)| {
-            *o = if driven[i] {
-                0.0
-            } else {
-                k.row_flow(i, theta) * inv[i]
-            };
+    if let Some(st) = stencils {
+        st.for_rows(theta, out, |i, s, o| {
+            *o = if driven[i] { 0.0 } else { s * inv[i] };
         });
+    } else {
+        out.par_chunks_mut(ROW_CHUNK)
+            .enumerate()
+            .for_each(|(c, o)| {
+                let first = c * ROW_CHUNK;
+                let rows = first..first + o.len();
+                let off = &k.offsets[first..=rows.end];
+                for ((((o, w), &d), &inv), &ti) in o
+                    .iter_mut()
+                    .zip(off.windows(2))
+                    .zip(&driven[rows.clone()])
+                    .zip(&inv[rows.clone()])
+                    .zip(&theta[rows])
+                {
+                    *o = if d {
+                        0.0
+                    } else {
+                        row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti) * inv
+                    };
+                }
+            });
+    }
     if model.boundary.has_loads() {
         model
             .boundary
@@ -149,6 +178,50 @@ fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64])
     }
 }
 
+/// One fused forward-Euler update of the body nodes, gather form: `next_i = θ_i + h·Σ_j K_ij
+/// (θ_j − θ_i)/(V_i ρc_i)` for free nodes, `θ_i` for driven ones (the boundary sets them
+/// after). The same bits as [`rates`] followed by `θ_i += h·rate_i`, in one pass; through the
+/// stencils of K when there are some.
+fn euler_fused(
+    model: &Model,
+    k: &Conductance,
+    stencils: Option<&Stencils>,
+    theta: &[f64],
+    h: f64,
+    next: &mut [f64],
+) {
+    let inv = &model.inv_heat_capacity;
+    let driven = &model.boundary.driven;
+    if let Some(st) = stencils {
+        st.for_rows(theta, next, |i, s, o| {
+            let ti = theta[i];
+            *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
+        });
+        return;
+    }
+    next.par_chunks_mut(ROW_CHUNK)
+        .enumerate()
+        .for_each(|(c, o)| {
+            let first = c * ROW_CHUNK;
+            let rows = first..first + o.len();
+            let off = &k.offsets[first..=rows.end];
+            for ((((o, w), &d), &inv), &ti) in o
+                .iter_mut()
+                .zip(off.windows(2))
+                .zip(&driven[rows.clone()])
+                .zip(&inv[rows.clone()])
+                .zip(&theta[rows])
+            {
+                *o = if d {
+                    ti
+                } else {
+                    let s = row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti);
+                    ti + h * (s * inv)
+                };
+            }
+        });
+}
+
 /// Explicit integrator state with preallocated buffers.
 pub struct Explicit<'a> {
     model: &'a Model,
@@ -159,6 +232,8 @@ pub struct Explicit<'a> {
     integrator: Integrator,
     k: [Vec<f64>; 4],
     stage: Vec<f64>,
+    /// K as shared stencils for the Euler step (lattice clouds without growing cracks).
+    stencils: Option<Stencils>,
 }
 
 impl<'a> Explicit<'a> {
@@ -188,7 +263,33 @@ impl<'a> Explicit<'a> {
             integrator,
             k,
             stage: vec![0.0; model.cloud.len()],
+            stencils: match integrator {
+                Integrator::Euler if model.growth.is_empty() => Stencils::build(&model.conductance),
+                _ => None,
+            },
         }
+    }
+
+    /// Turns the stencils of K ([`crate::stencil`]) on or off for the Euler step and tells
+    /// whether they are in use: they exist for Euler without growing cracks on clouds that
+    /// repeat rows (lattices). Off forces the plain CSR rows; both give the same bits.
+    pub fn set_stencils(&mut self, on: bool) -> bool {
+        self.stencils = match (on, self.stencils.take()) {
+            (false, _) => None,
+            (true, Some(s)) => Some(s),
+            (true, None)
+                if self.integrator == Integrator::Euler && self.model.growth.is_empty() =>
+            {
+                Stencils::build(&self.model.conductance)
+            }
+            (true, None) => None,
+        };
+        self.stencils.is_some()
+    }
+
+    /// Bytes held by the stencils of K (0 without them), B.
+    pub fn stencil_bytes(&self) -> usize {
+        self.stencils.as_ref().map_or(0, Stencils::bytes)
     }
 
     /// K as it is now (growing cracks cut it as their tips pass), W/K.
@@ -228,13 +329,24 @@ impl<'a> Explicit<'a> {
             | Integrator::Steady => {
                 panic!("implicit integrators run through solve::implicit, not Explicit")
             }
-            Integrator::Euler => {
-                rates(m, k, theta, t, &mut self.k[0]);
+            Integrator::Euler if m.boundary.has_loads() => {
+                rates_with(m, k, self.stencils.as_ref(), theta, t, &mut self.k[0]);
                 theta[..nb]
-                    .par_iter_mut()
-                    .with_min_len(4096)
-                    .zip(&self.k[0])
-                    .for_each(|(y, k)| *y += h * k);
+                    .par_chunks_mut(ROW_CHUNK)
+                    .zip(self.k[0].par_chunks(ROW_CHUNK))
+                    .for_each(|(y, r)| {
+                        for (y, r) in y.iter_mut().zip(r) {
+                            *y += h * r;
+                        }
+                    });
+            }
+            Integrator::Euler => {
+                // the new body temperatures into k[0], then back into θ (the caller's slice)
+                euler_fused(m, k, self.stencils.as_ref(), theta, h, &mut self.k[0]);
+                theta[..nb]
+                    .par_chunks_mut(ROW_CHUNK)
+                    .zip(self.k[0].par_chunks(ROW_CHUNK))
+                    .for_each(|(y, n)| y.copy_from_slice(n));
             }
             Integrator::Rk4 => {
                 let [k1, k2, k3, k4] = &mut self.k;
@@ -299,10 +411,14 @@ impl<'a> Explicit<'a> {
 }
 
 fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
-    out.par_iter_mut()
-        .with_min_len(4096)
-        .enumerate()
-        .for_each(|(i, o)| *o = y[i] + a * k[i]);
+    out.par_chunks_mut(ROW_CHUNK)
+        .zip(y.par_chunks(ROW_CHUNK))
+        .zip(k.par_chunks(ROW_CHUNK))
+        .for_each(|((o, y), k)| {
+            for ((o, y), k) in o.iter_mut().zip(y).zip(k) {
+                *o = y + a * k;
+            }
+        });
 }
 
 pub(crate) fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {

@@ -1,0 +1,487 @@
+//! `peritherm bench`: throughput of the explicit step against the machine's memory bandwidth.
+//!
+//! Measures, on this machine and with the same code the runs use: a STREAM-like triad
+//! (a_i = b_i + s c_i) on 1 and N threads, the bond updates per second of one forward-Euler
+//! step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3), the time of the neighbour search
+//! and of the assembly of K, and the bytes held per bond. Every figure is the median of
+//! repeated timings; nothing is estimated.
+
+use crate::case::Case;
+use crate::error::{Error, Result};
+use crate::model::{Geometry, Model};
+use crate::neighbors::Horizons;
+use crate::operator::{directed_weights, Conductance};
+use crate::run::run_case;
+use crate::solve::explicit::{Explicit, Integrator};
+use rayon::ThreadPool;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Bytes streamed per bond update by the bandwidth-bound model: a u32 column and an f64 K_ij.
+pub const BYTES_PER_BOND: f64 = 12.0;
+
+/// What `peritherm bench` measures and how long it takes.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
+    /// Small problems (about 10⁵ nodes) and few repetitions: a smoke run, not a measurement.
+    pub quick: bool,
+    /// Only the 2D m = 3 plate, with about this many nodes (e.g. 10⁷ for the memory check).
+    pub nodes: Option<usize>,
+    /// Threads of the parallel columns (the 1-thread column always runs too).
+    pub threads: usize,
+    /// Also run the explicit and implicit crack plate and thermal shock ([`CASES`], from the
+    /// repository root) with their outputs in this directory, and time them.
+    pub cases: Option<PathBuf>,
+}
+
+/// The explicit/implicit pairs of the README's "Implicit and steady solvers" comparison.
+pub const CASES: [&str; 4] = [
+    "cases/dh_crack_plate_k1_m1.toml",
+    "cases/dh_crack_plate_k1_m1_implicit.toml",
+    "cases/thermal_shock_k1_m1.toml",
+    "cases/thermal_shock_k1_m1_implicit.toml",
+];
+
+/// Time to solution of one case run by `peritherm bench --cases`.
+#[derive(Debug, Clone)]
+pub struct CaseRow {
+    /// Case file.
+    pub case: String,
+    /// Integrator name.
+    pub integrator: String,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Set-up (model, implicit elimination and symbolic factorisation), s.
+    pub setup: f64,
+    /// Integration with output writing, the reference excluded, s.
+    pub integration: f64,
+    /// max |θ_PD − θ_reference| at each output time, (s, °C).
+    pub errors: Vec<(f64, f64)>,
+}
+
+/// One row of the step table.
+#[derive(Debug, Clone)]
+pub struct StepRow {
+    /// Configuration name, e.g. "2D m = 3".
+    pub name: String,
+    /// Kernel: "CSR" (12 B streamed per bond) or "stencils" ([`crate::stencil`]).
+    pub kernel: &'static str,
+    /// Body nodes.
+    pub nodes: usize,
+    /// Stored pair conductances (bond updates per step).
+    pub bonds: usize,
+    /// Median time of one Euler step on 1 thread, s.
+    pub step_1: f64,
+    /// Median time of one Euler step on N threads, s.
+    pub step_n: f64,
+    /// Bytes held by Horizons + Conductance per stored pair conductance, B.
+    pub bytes_per_bond: f64,
+    /// Bytes held by the stencils per stored pair conductance (0 for CSR), B.
+    pub stencil_bytes_per_bond: f64,
+}
+
+/// Set-up times of a plate, s.
+#[derive(Debug, Clone)]
+pub struct SetupRow {
+    /// Configuration name.
+    pub name: String,
+    /// Body nodes.
+    pub nodes: usize,
+    /// Neighbour search ([`Horizons::build`]), s.
+    pub search: f64,
+    /// Directed weights ([`directed_weights`]), s.
+    pub weights: f64,
+    /// Assembly of K ([`Conductance::assemble`]), s.
+    pub assembly: f64,
+    /// The whole [`Model::build`] (cloud, search, weights, assembly, boundary), s.
+    pub build: f64,
+}
+
+/// Everything `peritherm bench` measured.
+#[derive(Debug, Clone)]
+pub struct BenchReport {
+    /// Threads of the parallel columns.
+    pub threads: usize,
+    /// Triad bandwidth on 1 thread, GB/s (24 bytes per element, STREAM's count).
+    pub triad_1: f64,
+    /// Triad bandwidth on N threads, GB/s.
+    pub triad_n: f64,
+    /// Explicit-step rows.
+    pub steps: Vec<StepRow>,
+    /// Set-up rows.
+    pub setup: Vec<SetupRow>,
+    /// Time-to-solution rows (with `--cases`).
+    pub cases: Vec<CaseRow>,
+    /// Peak resident set of the process at the end, bytes (Linux VmHWM; None elsewhere).
+    pub peak_rss: Option<u64>,
+}
+
+/// Runs [`CASES`] into `out/<case name>/` and times them.
+pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>> {
+    let mut rows = Vec::new();
+    for c in CASES {
+        let path = Path::new(c);
+        say(&format!("{c}: running"));
+        let case = Case::load(path)?;
+        let stem = path
+            .file_stem()
+            .map_or("case".into(), |s| s.to_string_lossy());
+        let s = run_case(&case, &out.join(stem.as_ref()), |_, _| {})?;
+        rows.push(CaseRow {
+            case: c.to_string(),
+            integrator: s.integrator.clone(),
+            steps: s.steps,
+            dt: s.dt,
+            setup: s.setup_seconds,
+            integration: s.wall_seconds,
+            errors: s
+                .reference
+                .iter()
+                .map(|r| (r.time, r.max_abs_diff))
+                .collect(),
+        });
+    }
+    Ok(rows)
+}
+
+fn pool(threads: usize) -> Result<ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::model("threads", e.to_string()))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// STREAM-like triad a_i = b_i + s·c_i over `len` f64 per array on `pool`: median bandwidth
+/// of `reps` passes, GB/s, counting 24 bytes per element as STREAM does.
+pub fn triad(pool: &ThreadPool, len: usize, reps: usize) -> f64 {
+    use rayon::prelude::*;
+    pool.install(|| {
+        let mut a = vec![0.0f64; len];
+        let b: Vec<f64> = (0..len).into_par_iter().map(|i| i as f64).collect();
+        let c: Vec<f64> = (0..len).into_par_iter().map(|i| 0.5 * i as f64).collect();
+        a.par_iter_mut().for_each(|x| *x = 1.0); // touch every page first
+        let s = 3.0;
+        let times: Vec<f64> = (0..reps)
+            .map(|_| {
+                let t = Instant::now();
+                a.par_chunks_mut(1 << 16)
+                    .zip(b.par_chunks(1 << 16))
+                    .zip(c.par_chunks(1 << 16))
+                    .for_each(|((a, b), c)| {
+                        for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
+                            *a = b + s * c;
+                        }
+                    });
+                t.elapsed().as_secs_f64()
+            })
+            .collect();
+        std::hint::black_box(&a);
+        24.0 * len as f64 / median(times) / 1e9
+    })
+}
+
+/// A free (insulated) plate or cube of `cells` per side, unit conductivity and capacity, p = 1,
+/// δ = m Δ: the configuration of the step table.
+pub fn plate(dim: usize, cells: usize, m: f64) -> Result<Case> {
+    let (min, max, n) = match dim {
+        2 => ("[0.0, 0.0]", "[1.0, 1.0]", format!("[{cells}, {cells}]")),
+        _ => (
+            "[0.0, 0.0, 0.0]",
+            "[1.0, 1.0, 1.0]",
+            format!("[{cells}, {cells}, {cells}]"),
+        ),
+    };
+    let text = format!(
+        r#"
+dimension = {dim}
+[domain]
+min = {min}
+max = {max}
+[[region]]
+name = "plate"
+cells = {n}
+horizon = {{ factor = {m} }}
+[material.m]
+conductivity = 1.0
+density = 1.0
+specific_heat = 1.0
+[kernel]
+p = 1
+[initial]
+value = "sin(3*x)*cos(2*y) + z"
+[time]
+end = 1.0
+integrator = "euler"
+"#
+    );
+    Case::parse(&text, Path::new("bench.toml"))
+}
+
+/// Bytes held by the bond data of a model (neighbour lists and K), B.
+pub fn bond_bytes(model: &Model) -> usize {
+    let h = &model.horizons;
+    let k = &model.conductance;
+    h.offsets.capacity() * 8
+        + h.targets.capacity() * 4
+        + h.beta.capacity() * 8
+        + k.offsets.capacity() * 8
+        + k.cols.capacity() * 4
+        + k.vals.capacity() * 8
+        + k.diag.capacity() * 8
+}
+
+/// Median wall time of one Euler step of `model` on `pool` over `reps` steps, s, through the
+/// stencils of K or the plain CSR rows; also the stencils' bytes (None when they are not used).
+pub fn time_step(
+    pool: &ThreadPool,
+    model: &Model,
+    reps: usize,
+    stencils: bool,
+) -> (f64, Option<usize>) {
+    pool.install(|| {
+        let dt = 0.5 * Integrator::Euler.stable_dt(model);
+        let mut theta = model.theta0.clone();
+        let mut st = Explicit::new(model, Integrator::Euler);
+        let used = st.set_stencils(stencils);
+        st.step(&mut theta, 0.0, dt); // warm-up
+        let times: Vec<f64> = (0..reps)
+            .map(|s| {
+                let t = Instant::now();
+                st.step(&mut theta, s as f64 * dt, dt);
+                t.elapsed().as_secs_f64()
+            })
+            .collect();
+        std::hint::black_box(&theta);
+        (median(times), used.then(|| st.stencil_bytes()))
+    })
+}
+
+/// Times the neighbour search, the directed weights and the assembly of a case's model, s.
+pub fn time_setup(pool: &ThreadPool, case: &Case) -> Result<[f64; 3]> {
+    let Geometry::Box(g) = &case.spec.geometry else {
+        return Err(Error::model("bench", "set-up timing needs a box geometry"));
+    };
+    pool.install(|| {
+        let cloud = g.generate(0, 0.0)?;
+        let t = Instant::now();
+        let horizons = Horizons::build(&cloud, &case.spec.kernel);
+        let search = t.elapsed().as_secs_f64();
+        let k: Vec<f64> = vec![case.spec.materials[0].conductivity; cloud.len()];
+        let t = Instant::now();
+        let w = directed_weights(
+            &cloud,
+            &horizons,
+            &case.spec.kernel,
+            &k,
+            case.spec.bond_rule,
+        );
+        let weights = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let kk = Conductance::assemble(&cloud, &horizons, &w);
+        let assembly = t.elapsed().as_secs_f64();
+        std::hint::black_box(&kk);
+        Ok([search, weights, assembly])
+    })
+}
+
+/// Peak resident set size of this process, bytes (Linux `VmHWM`), if known.
+pub fn peak_rss() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Runs the benchmark; `say` receives progress lines.
+pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport> {
+    let p1 = pool(1)?;
+    let pn = pool(opts.threads)?;
+    let (triad_len, reps) = if opts.quick {
+        (1 << 22, 5)
+    } else {
+        (1 << 26, 15)
+    };
+    say(&format!("triad, {} MB per array", (triad_len * 8) >> 20));
+    let triad_1 = triad(&p1, triad_len, reps);
+    let triad_n = triad(&pn, triad_len, reps);
+    let configs: Vec<(String, usize, usize, f64)> = match opts.nodes {
+        Some(n) => {
+            let c = (n as f64).sqrt().round().max(4.0) as usize;
+            vec![("2D m = 3".into(), 2, c, 3.0)]
+        }
+        None if opts.quick => vec![
+            ("2D m = 3".into(), 2, 300, 3.0),
+            ("2D m = 6.5".into(), 2, 300, 6.5),
+            ("3D m = 3".into(), 3, 45, 3.0),
+        ],
+        None => vec![
+            ("2D m = 3".into(), 2, 1000, 3.0),
+            ("2D m = 6.5".into(), 2, 1000, 6.5),
+            ("3D m = 3".into(), 3, 100, 3.0),
+        ],
+    };
+    let step_reps = if opts.quick { 5 } else { 21 };
+    let mut steps = Vec::new();
+    let mut setup = Vec::new();
+    for (name, dim, cells, m) in configs {
+        let case = plate(dim, cells, m)?;
+        if setup.is_empty() {
+            say(&format!("{name}: set-up"));
+            let mut s = Vec::new();
+            let mut w = Vec::new();
+            let mut a = Vec::new();
+            for _ in 0..if opts.quick || opts.nodes.is_some() {
+                1
+            } else {
+                3
+            } {
+                let [x, y, z] = time_setup(&pn, &case)?;
+                s.push(x);
+                w.push(y);
+                a.push(z);
+            }
+            let t = Instant::now();
+            let model = pn.install(|| Model::build(&case.spec))?;
+            let build = t.elapsed().as_secs_f64();
+            setup.push(SetupRow {
+                name: name.clone(),
+                nodes: model.cloud.n_body,
+                search: median(s),
+                weights: median(w),
+                assembly: median(a),
+                build,
+            });
+            drop(model);
+        }
+        say(&format!("{name}: build"));
+        let model = pn.install(|| Model::build(&case.spec))?;
+        say(&format!(
+            "{name}: {} nodes, {} bonds: steps",
+            model.cloud.n_body,
+            model.conductance.nnz()
+        ));
+        let nnz = model.conductance.nnz() as f64;
+        for (kernel, on) in [("CSR", false), ("stencils", true)] {
+            let (step_1, used) = time_step(&p1, &model, step_reps, on);
+            let Some(held) = (if on { used } else { Some(0) }) else {
+                say(&format!("{name}: no stencils (rows do not repeat)"));
+                continue;
+            };
+            let (step_n, _) = time_step(&pn, &model, step_reps, on);
+            steps.push(StepRow {
+                name: name.clone(),
+                kernel,
+                nodes: model.cloud.n_body,
+                bonds: model.conductance.nnz(),
+                step_1,
+                step_n,
+                bytes_per_bond: bond_bytes(&model) as f64 / nnz,
+                stencil_bytes_per_bond: held as f64 / nnz,
+            });
+        }
+    }
+    let cases = match &opts.cases {
+        Some(dir) => time_cases(dir, &mut say)?,
+        None => Vec::new(),
+    };
+    Ok(BenchReport {
+        cases,
+        threads: opts.threads,
+        triad_1,
+        triad_n,
+        steps,
+        setup,
+        peak_rss: peak_rss(),
+    })
+}
+
+impl BenchReport {
+    /// The report as Markdown tables.
+    pub fn markdown(&self) -> String {
+        let n = self.threads;
+        let lim = |gbs: f64| gbs * 1e9 / BYTES_PER_BOND;
+        let mut s = String::new();
+        s += "| memory bandwidth (STREAM-like triad) | 1 thread | ";
+        s += &format!("{n} threads |\n|---|---|---|\n");
+        s += &format!(
+            "| triad, GB/s | {:.1} | {:.1} |\n| bond-update limit at {BYTES_PER_BOND} B/bond, 10⁹/s | {:.2} | {:.2} |\n\n",
+            self.triad_1,
+            self.triad_n,
+            lim(self.triad_1) / 1e9,
+            lim(self.triad_n) / 1e9
+        );
+        s += &format!(
+            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, {n} threads | of the 12 B/bond limit | B held per bond (+ stencils) |\n"
+        );
+        s += "|---|---|---|---|---|---|---|---|---|---|\n";
+        for r in &self.steps {
+            let rate = r.bonds as f64 / r.step_n;
+            s += &format!(
+                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} × 10⁹ | {:.0} % | {:.1} (+ {:.2}) |\n",
+                r.name,
+                r.kernel,
+                r.nodes,
+                r.bonds,
+                r.step_1 * 1e3,
+                r.step_n * 1e3,
+                r.step_1 / r.step_n,
+                rate / 1e9,
+                100.0 * rate / lim(self.triad_n),
+                r.bytes_per_bond,
+                r.stencil_bytes_per_bond
+            );
+        }
+        s += "\n| set-up | nodes | neighbour search | directed weights | assembly of K | search + weights + assembly | whole Model::build |\n|---|---|---|---|---|---|---|\n";
+        for r in &self.setup {
+            s += &format!(
+                "| {} | {} | {:.2} s | {:.2} s | {:.2} s | {:.2} s | {:.2} s |\n",
+                r.name,
+                r.nodes,
+                r.search,
+                r.weights,
+                r.assembly,
+                r.search + r.weights + r.assembly,
+                r.build
+            );
+        }
+        if !self.cases.is_empty() {
+            s += "\n| case | integrator | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|\n";
+            for r in &self.cases {
+                let errors: Vec<String> = r
+                    .errors
+                    .iter()
+                    .map(|(t, e)| format!("{e:.3e} at {t} s"))
+                    .collect();
+                s += &format!(
+                    "| `{}` | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                    r.case,
+                    r.integrator,
+                    r.dt,
+                    r.steps,
+                    r.setup,
+                    r.integration,
+                    r.setup + r.integration,
+                    errors.join(", ")
+                );
+            }
+        }
+        if let Some(b) = self.peak_rss {
+            s += &format!("\nPeak resident set: {:.2} GB\n", b as f64 / 1e9);
+        }
+        s
+    }
+}
