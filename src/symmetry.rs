@@ -60,6 +60,9 @@ impl Symmetry {
     #[inline]
     pub fn pair_factor(&self, ri: f64, rj: f64) -> f64 {
         use std::f64::consts::PI;
+        // the same operations in the same order either way, so that the factor is symmetric
+        // bit for bit (a product's value depends on its association order)
+        let (ri, rj) = if ri <= rj { (ri, rj) } else { (rj, ri) };
         match self {
             Symmetry::Planar => 1.0,
             Symmetry::Axisymmetric => 2.0 * PI * 2.0 * ri * rj / (ri + rj),
