@@ -14,6 +14,7 @@ use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::run::run_case;
 use crate::solve::explicit::{Explicit, Integrator};
+use crate::stencil::Stencils;
 use rayon::ThreadPool;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -60,6 +61,8 @@ pub struct CaseRow {
     pub integration: f64,
     /// max |θ_PD − θ_reference| at each output time, (s, °C).
     pub errors: Vec<(f64, f64)>,
+    /// For Euler runs: stencil entries over K's entries when the step used stencils, else None.
+    pub stencils: Option<f64>,
 }
 
 /// One row of the step table.
@@ -134,6 +137,17 @@ pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>>
             .file_stem()
             .map_or("case".into(), |s| s.to_string_lossy());
         let s = run_case(&case, &out.join(stem.as_ref()), |_, _| {})?;
+        // what Explicit::new decided for this model (built again: a second or less here)
+        let stencils = if case.integrator == Integrator::Euler {
+            let model = Model::build(&case.spec)?;
+            let mut st = Explicit::new(&model, Integrator::Euler);
+            st.set_stencils(true).then(|| {
+                let k = &model.conductance;
+                Stencils::build(k).map_or(1.0, |s| s.entries() as f64 / k.nnz() as f64)
+            })
+        } else {
+            None
+        };
         rows.push(CaseRow {
             case: c.to_string(),
             integrator: s.integrator.clone(),
@@ -508,17 +522,23 @@ impl BenchReport {
             );
         }
         if !self.cases.is_empty() {
-            s += "\n| case | integrator | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|\n";
+            s += "\n| case | integrator | K as | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|\n";
             for r in &self.cases {
                 let errors: Vec<String> = r
                     .errors
                     .iter()
                     .map(|(t, e)| format!("{e:.3e} at {t} s"))
                     .collect();
+                let kas = match (r.integrator.as_str(), r.stencils) {
+                    ("euler", Some(f)) => format!("stencils ({:.1} % of K's entries)", 100.0 * f),
+                    ("euler", None) => "CSR".to_string(),
+                    _ => "factorised".to_string(),
+                };
                 s += &format!(
-                    "| `{}` | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                    "| `{}` | {} | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
                     r.case,
                     r.integrator,
+                    kas,
                     r.dt,
                     r.steps,
                     r.setup,
