@@ -2,9 +2,10 @@
 //!
 //! Measures, on this machine and with the same code the runs use: a STREAM-like triad
 //! (a_i = b_i + s c_i) on 1 and N threads, the bond updates per second of one forward-Euler
-//! step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3), the time of the neighbour search
-//! and of the assembly of K, and the bytes held per bond. Every figure is the median of
-//! repeated timings; nothing is estimated.
+//! step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3) through the CSR rows and the stencils
+//! of K, each step after a triad pass on the same threads (the machine may be shared: both see
+//! the same load), the time of the neighbour search and of the assembly of K, and the bytes
+//! held per bond. Every figure is the median of repeated timings; nothing is estimated.
 
 use crate::case::Case;
 use crate::error::{Error, Result};
@@ -13,6 +14,7 @@ use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::run::run_case;
 use crate::solve::explicit::{Explicit, Integrator};
+use crate::stencil::Stencils;
 use rayon::ThreadPool;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -59,6 +61,8 @@ pub struct CaseRow {
     pub integration: f64,
     /// max |θ_PD − θ_reference| at each output time, (s, °C).
     pub errors: Vec<(f64, f64)>,
+    /// For Euler runs: stencil entries over K's entries when the step used stencils, else None.
+    pub stencils: Option<f64>,
 }
 
 /// One row of the step table.
@@ -76,6 +80,10 @@ pub struct StepRow {
     pub step_1: f64,
     /// Median time of one Euler step on N threads, s.
     pub step_n: f64,
+    /// Median triad bandwidth on 1 thread measured between the steps, GB/s.
+    pub triad_1: f64,
+    /// Median triad bandwidth on N threads measured between the steps, GB/s.
+    pub triad_n: f64,
     /// Bytes held by Horizons + Conductance per stored pair conductance, B.
     pub bytes_per_bond: f64,
     /// Bytes held by the stencils per stored pair conductance (0 for CSR), B.
@@ -129,6 +137,17 @@ pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>>
             .file_stem()
             .map_or("case".into(), |s| s.to_string_lossy());
         let s = run_case(&case, &out.join(stem.as_ref()), |_, _| {})?;
+        // what Explicit::new decided for this model (built again: a second or less here)
+        let stencils = if case.integrator == Integrator::Euler {
+            let model = Model::build(&case.spec)?;
+            let mut st = Explicit::new(&model, Integrator::Euler);
+            st.set_stencils(true).then(|| {
+                let k = &model.conductance;
+                Stencils::build(k).map_or(1.0, |s| s.entries() as f64 / k.nnz() as f64)
+            })
+        } else {
+            None
+        };
         rows.push(CaseRow {
             case: c.to_string(),
             integrator: s.integrator.clone(),
@@ -165,33 +184,56 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// STREAM-like triad a_i = b_i + s·c_i over `len` f64 per array on `pool`: median bandwidth
-/// of `reps` passes, GB/s, counting 24 bytes per element as STREAM does.
-pub fn triad(pool: &ThreadPool, len: usize, reps: usize) -> f64 {
-    use rayon::prelude::*;
-    pool.install(|| {
-        let mut a = vec![0.0f64; len];
-        let b: Vec<f64> = (0..len).into_par_iter().map(|i| i as f64).collect();
-        let c: Vec<f64> = (0..len).into_par_iter().map(|i| 0.5 * i as f64).collect();
-        a.par_iter_mut().for_each(|x| *x = 1.0); // touch every page first
+/// The arrays of a STREAM-like triad a_i = b_i + s·c_i.
+pub struct Triad {
+    a: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+}
+
+impl Triad {
+    /// Three arrays of `len` f64, every page touched.
+    pub fn new(len: usize) -> Triad {
+        use rayon::prelude::*;
+        Triad {
+            a: vec![1.0; len],
+            b: (0..len).into_par_iter().map(|i| i as f64).collect(),
+            c: (0..len).into_par_iter().map(|i| 0.5 * i as f64).collect(),
+        }
+    }
+
+    /// One pass on `pool`, s.
+    pub fn pass(&mut self, pool: &ThreadPool) -> f64 {
+        use rayon::prelude::*;
+        let (a, b, c) = (&mut self.a, &self.b, &self.c);
         let s = 3.0;
-        let times: Vec<f64> = (0..reps)
-            .map(|_| {
-                let t = Instant::now();
-                a.par_chunks_mut(1 << 16)
-                    .zip(b.par_chunks(1 << 16))
-                    .zip(c.par_chunks(1 << 16))
-                    .for_each(|((a, b), c)| {
-                        for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
-                            *a = b + s * c;
-                        }
-                    });
-                t.elapsed().as_secs_f64()
-            })
-            .collect();
-        std::hint::black_box(&a);
-        24.0 * len as f64 / median(times) / 1e9
-    })
+        let t = Instant::now();
+        pool.install(|| {
+            a.par_chunks_mut(1 << 16)
+                .zip(b.par_chunks(1 << 16))
+                .zip(c.par_chunks(1 << 16))
+                .for_each(|((a, b), c)| {
+                    for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
+                        *a = b + s * c;
+                    }
+                })
+        });
+        let dt = t.elapsed().as_secs_f64();
+        std::hint::black_box(&self.a);
+        dt
+    }
+
+    /// Bandwidth of a pass that took `seconds`, GB/s, counting 24 bytes per element as STREAM
+    /// does.
+    pub fn gbs(&self, seconds: f64) -> f64 {
+        24.0 * self.a.len() as f64 / seconds / 1e9
+    }
+
+    /// Median bandwidth of `reps` passes on `pool`, GB/s.
+    pub fn median_gbs(&mut self, pool: &ThreadPool, reps: usize) -> f64 {
+        let t: Vec<f64> = (0..reps).map(|_| self.pass(pool)).collect();
+        self.gbs(median(t))
+    }
 }
 
 /// A free (insulated) plate or cube of `cells` per side, unit conductivity and capacity, p = 1,
@@ -244,30 +286,41 @@ pub fn bond_bytes(model: &Model) -> usize {
         + k.diag.capacity() * 8
 }
 
-/// Median wall time of one Euler step of `model` on `pool` over `reps` steps, s, through the
-/// stencils of K or the plain CSR rows; also the stencils' bytes (None when they are not used).
+/// Euler steps of `model` on `pool` in three blocks of `reps / 3`, each block after two triad
+/// passes on the same pool and one discarded step (so that steps and triad see the same load
+/// from elsewhere, and no timed step pays for evicting the triad's arrays), through the
+/// stencils of K or the plain CSR rows: median step, s, median triad bandwidth, GB/s, and the
+/// stencils' bytes (None when they are not used).
 pub fn time_step(
     pool: &ThreadPool,
     model: &Model,
     reps: usize,
     stencils: bool,
-) -> (f64, Option<usize>) {
-    pool.install(|| {
-        let dt = 0.5 * Integrator::Euler.stable_dt(model);
-        let mut theta = model.theta0.clone();
-        let mut st = Explicit::new(model, Integrator::Euler);
-        let used = st.set_stencils(stencils);
-        st.step(&mut theta, 0.0, dt); // warm-up
-        let times: Vec<f64> = (0..reps)
-            .map(|s| {
-                let t = Instant::now();
-                st.step(&mut theta, s as f64 * dt, dt);
-                t.elapsed().as_secs_f64()
-            })
-            .collect();
-        std::hint::black_box(&theta);
-        (median(times), used.then(|| st.stencil_bytes()))
-    })
+    triad: &mut Triad,
+) -> (f64, f64, Option<usize>) {
+    let dt = 0.5 * Integrator::Euler.stable_dt(model);
+    let mut theta = model.theta0.clone();
+    let mut st = pool.install(|| Explicit::new(model, Integrator::Euler));
+    let used = pool.install(|| st.set_stencils(stencils));
+    let mut steps = Vec::with_capacity(reps);
+    let mut passes = Vec::new();
+    let per_block = reps.div_ceil(3).max(1);
+    for _ in 0..3 {
+        passes.push(triad.pass(pool));
+        passes.push(triad.pass(pool));
+        pool.install(|| st.step(&mut theta, 0.0, dt)); // not timed
+        for _ in 0..per_block {
+            let t = Instant::now();
+            pool.install(|| st.step(&mut theta, 0.0, dt));
+            steps.push(t.elapsed().as_secs_f64());
+        }
+    }
+    std::hint::black_box(&theta);
+    (
+        median(steps),
+        triad.gbs(median(passes)),
+        used.then(|| st.stencil_bytes()),
+    )
 }
 
 /// Times the neighbour search, the directed weights and the assembly of a case's model, s.
@@ -316,8 +369,11 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         (1 << 26, 15)
     };
     say(&format!("triad, {} MB per array", (triad_len * 8) >> 20));
-    let triad_1 = triad(&p1, triad_len, reps);
-    let triad_n = triad(&pn, triad_len, reps);
+    let mut triad = Triad::new(triad_len);
+    let triad_1 = triad.median_gbs(&p1, reps);
+    let triad_n = triad.median_gbs(&pn, reps);
+    // made again beside each model, so that it does not add to the build's peak memory
+    drop(triad);
     let configs: Vec<(String, usize, usize, f64)> = match opts.nodes {
         Some(n) => {
             let c = (n as f64).sqrt().round().max(4.0) as usize;
@@ -375,13 +431,14 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
             model.conductance.nnz()
         ));
         let nnz = model.conductance.nnz() as f64;
+        let mut triad = Triad::new(triad_len);
         for (kernel, on) in [("CSR", false), ("stencils", true)] {
-            let (step_1, used) = time_step(&p1, &model, step_reps, on);
+            let (step_1, triad_1, used) = time_step(&p1, &model, step_reps, on, &mut triad);
             let Some(held) = (if on { used } else { Some(0) }) else {
                 say(&format!("{name}: no stencils (rows do not repeat)"));
                 continue;
             };
-            let (step_n, _) = time_step(&pn, &model, step_reps, on);
+            let (step_n, triad_n, _) = time_step(&pn, &model, step_reps, on, &mut triad);
             steps.push(StepRow {
                 name: name.clone(),
                 kernel,
@@ -389,6 +446,8 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
                 bonds: model.conductance.nnz(),
                 step_1,
                 step_n,
+                triad_1,
+                triad_n,
                 bytes_per_bond: bond_bytes(&model) as f64 / nnz,
                 stencil_bytes_per_bond: held as f64 / nnz,
             });
@@ -425,13 +484,13 @@ impl BenchReport {
             lim(self.triad_n) / 1e9
         );
         s += &format!(
-            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, {n} threads | of the 12 B/bond limit | B held per bond (+ stencils) |\n"
+            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | triad alongside, 1 / {n} threads | of the 12 B/bond limit, 1 / {n} threads | B held per bond (+ stencils) |\n"
         );
-        s += "|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|\n";
         for r in &self.steps {
-            let rate = r.bonds as f64 / r.step_n;
+            let (r1, rn) = (r.bonds as f64 / r.step_1, r.bonds as f64 / r.step_n);
             s += &format!(
-                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} × 10⁹ | {:.0} % | {:.1} (+ {:.2}) |\n",
+                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} / {:.2} × 10⁹ | {:.1} / {:.1} GB/s | {:.0} / {:.0} % | {:.1} (+ {:.2}) |\n",
                 r.name,
                 r.kernel,
                 r.nodes,
@@ -439,8 +498,12 @@ impl BenchReport {
                 r.step_1 * 1e3,
                 r.step_n * 1e3,
                 r.step_1 / r.step_n,
-                rate / 1e9,
-                100.0 * rate / lim(self.triad_n),
+                r1 / 1e9,
+                rn / 1e9,
+                r.triad_1,
+                r.triad_n,
+                100.0 * r1 / lim(r.triad_1),
+                100.0 * rn / lim(r.triad_n),
                 r.bytes_per_bond,
                 r.stencil_bytes_per_bond
             );
@@ -459,17 +522,23 @@ impl BenchReport {
             );
         }
         if !self.cases.is_empty() {
-            s += "\n| case | integrator | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|\n";
+            s += "\n| case | integrator | K as | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|\n";
             for r in &self.cases {
                 let errors: Vec<String> = r
                     .errors
                     .iter()
                     .map(|(t, e)| format!("{e:.3e} at {t} s"))
                     .collect();
+                let kas = match (r.integrator.as_str(), r.stencils) {
+                    ("euler", Some(f)) => format!("stencils ({:.1} % of K's entries)", 100.0 * f),
+                    ("euler", None) => "CSR".to_string(),
+                    _ => "factorised".to_string(),
+                };
                 s += &format!(
-                    "| `{}` | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                    "| `{}` | {} | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
                     r.case,
                     r.integrator,
+                    kas,
                     r.dt,
                     r.steps,
                     r.setup,

@@ -146,8 +146,11 @@ impl Conductance {
         let nb = cloud.n_body;
         let targets = &horizons.targets;
         let row = |i: usize| &targets[horizons.row(i)];
-        // bonds j -> i into a body node i that has no bond i -> j: (i, j, w_ji)
-        let mut lone: Vec<(NodeId, NodeId, f64)> = (0..n)
+        // bonds j -> i into a body node i that has no bond i -> j: (i, j, w_ji); none when
+        // every node has the same horizon and spacing (β_ij = β_ji: the relation is symmetric)
+        let uniform = |v: &[f64]| v.iter().all(|x| x.to_bits() == v[0].to_bits());
+        let symmetric = n > 0 && uniform(&cloud.horizon) && uniform(&cloud.spacing);
+        let mut lone: Vec<(NodeId, NodeId, f64)> = (0..if symmetric { 0 } else { n })
             .into_par_iter()
             .with_min_len(1024)
             .flat_map_iter(|j| {

@@ -112,6 +112,9 @@ impl Stencils {
                         }
                     };
                 }
+                blk.start.shrink_to_fit();
+                blk.delta.shrink_to_fit();
+                blk.vals.shrink_to_fit();
                 Some(blk)
             })
             .collect();

@@ -204,10 +204,18 @@ fn uniform_plate(faces: &str) -> Model {
 
 /// The parallel assembly gives, bit for bit, K_ij = w_ij + w_ji (w_ij alone, or w_ji alone, for
 /// one-way bonds) with sorted columns and row sums in column order, on a dual-horizon cloud
-/// with fictitious layers (one-way bonds at the horizon change).
+/// with fictitious layers (one-way bonds at the horizon change) and on a uniform one (none).
 #[test]
 fn assembly_matches_a_pairwise_reference() {
-    let model = refined_dual_horizon(MIRROR_FACES);
+    for model in [
+        refined_dual_horizon(MIRROR_FACES),
+        uniform_plate(MIRROR_FACES),
+    ] {
+        assembly_check(&model);
+    }
+}
+
+fn assembly_check(model: &Model) {
     let spec = dual_horizon_case("", "lattice").spec;
     let (c, h) = (&model.cloud, &model.horizons);
     let w = peritherm::operator::directed_weights(
@@ -247,7 +255,16 @@ fn assembly_matches_a_pairwise_reference() {
         assert_eq!(k.vals[r], vals[..], "row {i}");
         assert_eq!(k.diag[i], vals.iter().sum::<f64>(), "row {i}");
     }
-    assert!(one_way > 0);
+    let uniform = model
+        .cloud
+        .horizon
+        .iter()
+        .all(|&d| d == model.cloud.horizon[0]);
+    assert_eq!(
+        one_way > 0,
+        !uniform,
+        "one-way bonds exactly where horizons differ"
+    );
 }
 
 /// The parallel gather gives bit-identical results to the serial loop.

@@ -330,7 +330,12 @@ impl<'a> Explicit<'a> {
                 panic!("implicit integrators run through solve::implicit, not Explicit")
             }
             Integrator::Euler if m.boundary.has_loads() => {
-                rates_with(m, k, self.stencils.as_ref(), theta, t, &mut self.k[0]);
+                // built from the model's K: not used once something owns a copy of K to change it
+                let st = match self.conductance {
+                    Cow::Borrowed(_) => self.stencils.as_ref(),
+                    Cow::Owned(_) => None,
+                };
+                rates_with(m, k, st, theta, t, &mut self.k[0]);
                 theta[..nb]
                     .par_chunks_mut(ROW_CHUNK)
                     .zip(self.k[0].par_chunks(ROW_CHUNK))
@@ -342,7 +347,12 @@ impl<'a> Explicit<'a> {
             }
             Integrator::Euler => {
                 // the new body temperatures into k[0], then back into θ (the caller's slice)
-                euler_fused(m, k, self.stencils.as_ref(), theta, h, &mut self.k[0]);
+                // built from the model's K: not used once something owns a copy of K to change it
+                let st = match self.conductance {
+                    Cow::Borrowed(_) => self.stencils.as_ref(),
+                    Cow::Owned(_) => None,
+                };
+                euler_fused(m, k, st, theta, h, &mut self.k[0]);
                 theta[..nb]
                     .par_chunks_mut(ROW_CHUNK)
                     .zip(self.k[0].par_chunks(ROW_CHUNK))
