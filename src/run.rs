@@ -18,7 +18,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Runs `case`, writing its outputs into `out`; `progress(done, total)` reports steps.
-pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<RunSummary> {
+pub fn run_case(case: &Case, out: &Path, progress: impl FnMut(u64, u64)) -> Result<RunSummary> {
     let t_setup = Instant::now();
     let model = Model::build(&case.spec).map_err(|e| match e {
         Error::Model { key, message } => Error::Case {
@@ -28,6 +28,17 @@ pub fn run_case(case: &Case, out: &Path, mut progress: impl FnMut(u64, u64)) -> 
         },
         other => other,
     })?;
+    run_model(case, &model, out, t_setup, progress)
+}
+
+/// Runs `case` on its already built `model` (set-up timed from `t_setup`), writing into `out`.
+pub fn run_model(
+    case: &Case,
+    model: &Model,
+    out: &Path,
+    t_setup: Instant,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunSummary> {
     let in_case = |e: Error| match e {
         Error::UnstableDt { .. } => Error::Case {
             file: case.path.clone(),

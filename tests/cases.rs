@@ -1,8 +1,9 @@
-//! Every bundled case parses, builds, honours its own stability bound and runs a few steps.
+//! Every bundled case parses, builds, honours its own stability bound and runs a few steps
+//! (each model is built once and reused for the run).
 
 use peritherm::case::Case;
 use peritherm::model::Model;
-use peritherm::run::run_case;
+use peritherm::run::run_model;
 use std::path::Path;
 
 #[test]
@@ -39,7 +40,7 @@ fn every_case_builds_and_starts() {
             case.reference = None;
         }
         let out = tempfile::tempdir().unwrap();
-        let s = run_case(&case, out.path(), |_, _| {}).unwrap();
+        let s = run_model(&case, &model, out.path(), started, |_, _| {}).unwrap();
         assert_eq!(s.steps, 3, "{}", path.display());
         assert!(out.path().join("field_1.csv").exists());
         eprintln!(
