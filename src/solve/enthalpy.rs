@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::material::Enthalpy;
 use crate::model::Model;
 use crate::operator::Conductance;
-use crate::solve::explicit::{check_finite, steps_between, Integrator, RunStats};
+use crate::solve::explicit::{march, Integrator, RunStats, Stepper};
 use rayon::prelude::*;
 
 /// Enthalpy-form explicit integrator state with preallocated buffers.
@@ -205,35 +205,32 @@ impl<'a> Enthalpic<'a> {
         dt: f64,
         outputs: &[f64],
         mut on_output: impl FnMut(usize, f64, &[f64], &Conductance, f64) -> Result<()>,
-        mut progress: impl FnMut(u64),
+        progress: impl FnMut(u64),
     ) -> Result<RunStats> {
         if !self.ready {
             self.start(theta, t0);
         }
-        let mut t = t0;
-        let mut stats = RunStats::default();
-        let nb = self.model.cloud.n_body;
-        for (k, &to) in outputs.iter().enumerate() {
-            let n = steps_between(t, to, dt);
-            let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
-            for s in 0..n {
-                let tn = t + s as f64 * h;
-                self.step(theta, tn, h);
-                stats.steps += 1;
-                if stats.steps % 256 == 0 {
-                    progress(stats.steps);
-                    if stats.steps % 4096 == 0 {
-                        check_finite(theta, nb, tn + h)?;
-                    }
-                }
-            }
-            t = to;
-            check_finite(theta, nb, t)?;
-            self.scale_conductance();
-            let energy = self.energy();
-            on_output(k, t, theta, &self.scaled, energy)?;
-        }
-        progress(stats.steps);
-        Ok(stats)
+        march(
+            self,
+            theta,
+            t0,
+            dt,
+            outputs,
+            |me, k, t, theta| {
+                me.scale_conductance();
+                let energy = me.energy();
+                on_output(k, t, theta, &me.scaled, energy)
+            },
+            progress,
+        )
+    }
+}
+
+impl Stepper for Enthalpic<'_> {
+    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        self.step(theta, t, h);
+    }
+    fn n_body(&self) -> usize {
+        self.model.cloud.n_body
     }
 }

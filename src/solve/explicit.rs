@@ -392,32 +392,75 @@ impl<'a> Explicit<'a> {
         dt: f64,
         outputs: &[f64],
         mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
-        mut progress: impl FnMut(u64),
+        progress: impl FnMut(u64),
     ) -> Result<RunStats> {
-        let mut t = t0;
-        let mut stats = RunStats::default();
-        for (k, &to) in outputs.iter().enumerate() {
-            let n = steps_between(t, to, dt);
-            let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
-            for s in 0..n {
-                let tn = t + s as f64 * h;
-                self.step(theta, tn, h);
-                stats.steps += 1;
-                if stats.steps % 256 == 0 {
-                    progress(stats.steps);
-                    if stats.steps % 4096 == 0 {
-                        check_finite(theta, self.model.cloud.n_body, tn + h)?;
-                    }
+        march(
+            self,
+            theta,
+            t0,
+            dt,
+            outputs,
+            |me, k, t, theta| {
+                me.cut_until(t);
+                on_output(k, t, theta, &me.conductance)
+            },
+            progress,
+        )
+    }
+}
+
+/// A fixed-step explicit integrator that [`march`] can drive.
+pub(crate) trait Stepper {
+    /// Advances the body temperatures in `theta` from t over h, s.
+    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64);
+    /// Number of body nodes (the entries of θ that are checked for NaN).
+    fn n_body(&self) -> usize;
+}
+
+impl Stepper for Explicit<'_> {
+    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        self.step(theta, t, h);
+    }
+    fn n_body(&self) -> usize {
+        self.model.cloud.n_body
+    }
+}
+
+/// The fixed-step time loop shared by the explicit integrators: steps no longer than `dt` that
+/// land on each output time, a NaN check every 4096 steps and at every output, where
+/// `at_output(stepper, k, t, θ)` is called; `progress(steps)` every 256 steps and at the end.
+pub(crate) fn march<S: Stepper>(
+    stepper: &mut S,
+    theta: &mut [f64],
+    t0: f64,
+    dt: f64,
+    outputs: &[f64],
+    mut at_output: impl FnMut(&mut S, usize, f64, &[f64]) -> Result<()>,
+    mut progress: impl FnMut(u64),
+) -> Result<RunStats> {
+    let nb = stepper.n_body();
+    let mut t = t0;
+    let mut stats = RunStats::default();
+    for (k, &to) in outputs.iter().enumerate() {
+        let n = steps_between(t, to, dt);
+        let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
+        for s in 0..n {
+            let tn = t + s as f64 * h;
+            stepper.advance(theta, tn, h);
+            stats.steps += 1;
+            if stats.steps % 256 == 0 {
+                progress(stats.steps);
+                if stats.steps % 4096 == 0 {
+                    check_finite(theta, nb, tn + h)?;
                 }
             }
-            t = to;
-            check_finite(theta, self.model.cloud.n_body, t)?;
-            self.cut_until(t);
-            on_output(k, t, theta, &self.conductance)?;
         }
-        progress(stats.steps);
-        Ok(stats)
+        t = to;
+        check_finite(theta, nb, t)?;
+        at_output(stepper, k, t, theta)?;
     }
+    progress(stats.steps);
+    Ok(stats)
 }
 
 fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
