@@ -5,7 +5,7 @@
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
-use peritherm::solve::implicit::{Implicit, Options, Ordering, Scheme, Solver};
+use peritherm::solve::implicit::{Adaptive, Implicit, Options, Ordering, Scheme, Solver};
 use std::path::Path;
 
 /// A 1D bar, 100 nodes, δ = 3Δ, the left end following θ = 5t·e^(−2t) through a mirrored layer,
@@ -404,4 +404,119 @@ fn print_asymmetry() {
             sys.asymmetry, sys.symmetric
         );
     }
+}
+
+/// Body temperatures at each output time of an adaptive run, and its counters.
+fn adaptive(
+    model: &Model,
+    scheme: Scheme,
+    tolerance: f64,
+    outputs: &[f64],
+    options: Options,
+) -> (Vec<Vec<f64>>, peritherm::solve::implicit::ImplicitStats) {
+    let mut theta = model.theta0.clone();
+    let mut st = Implicit::new(model, scheme, options).unwrap();
+    let mut fields = Vec::new();
+    let nb = model.cloud.n_body;
+    let a = Adaptive {
+        tolerance,
+        first: None,
+        max: None,
+    };
+    st.run_adaptive(
+        &mut theta,
+        0.0,
+        &a,
+        outputs,
+        |_, _, th, _| {
+            fields.push(th[..nb].to_vec());
+            Ok(())
+        },
+        |_, _| {},
+    )
+    .unwrap();
+    (fields, st.stats)
+}
+
+/// Body temperatures at each output time of an RK4 run at a quarter of its stable step: the
+/// time-converged semi-discrete solution (its error, O(dt⁴) ~ 1e-15 °C, is far below every
+/// tolerance used here).
+fn rk4_outputs(model: &Model, outputs: &[f64]) -> Vec<Vec<f64>> {
+    let dt = choose_dt(model, Integrator::Rk4, None).unwrap() / 4.0;
+    let mut theta = model.theta0.clone();
+    let mut st = Explicit::new(model, Integrator::Rk4);
+    let nb = model.cloud.n_body;
+    let mut fields = Vec::new();
+    st.run(
+        &mut theta,
+        0.0,
+        dt,
+        outputs,
+        |_, _, th, _| {
+            fields.push(th[..nb].to_vec());
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap();
+    fields
+}
+
+#[test]
+#[ignore]
+fn explore_adaptive() {
+    let case = bar(
+        "type = \"temperature\"\nmethod = \"mirror\"\nvalue = \"5*t*exp(-2*t)\"",
+        "type = \"insulated\"",
+        "0",
+    );
+    let model = Model::build(&case.spec).unwrap();
+    let outputs = [0.3, 0.55, 1.0];
+    let reference = rk4_outputs(&model, &outputs);
+    for scheme in [Scheme::BackwardEuler, Scheme::CrankNicolson, Scheme::Bdf2] {
+        for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
+            let (f, s) = adaptive(&model, scheme, tol, &outputs, Options::default());
+            let e: Vec<f64> = f.iter().zip(&reference).map(|(a, b)| max_diff(a, b) / tol).collect();
+            println!("{scheme:?} tol {tol:e}: err/tol {e:.3?} acc {} rej {} solves {} fact {} cg {}", s.accepted, s.rejected, s.solves, s.factorisations, s.cg_solves);
+        }
+    }
+    let case = bar(
+        "type = \"temperature\"\nmethod = \"mirror\"\nvalue = 1.0",
+        "type = \"insulated\"",
+        "0",
+    );
+    let model = Model::build(&case.spec).unwrap();
+    let outputs = [2e-3];
+    let reference = rk4_outputs(&model, &outputs);
+    for scheme in [Scheme::BackwardEuler, Scheme::CrankNicolson, Scheme::Bdf2] {
+        for tol in [1e-3, 1e-4, 1e-5, 1e-6] {
+            let (f, s) = adaptive(&model, scheme, tol, &outputs, Options { solver: Solver::Auto, ..Options::default() });
+            let e: Vec<f64> = f.iter().zip(&reference).map(|(a, b)| max_diff(a, b)).collect();
+            println!("jump {scheme:?} tol {tol:e}: err {:?} acc {} rej {} solves {} fact {} cg {}", e.iter().map(|v| format!("{v:.2e}")).collect::<Vec<_>>(), s.accepted, s.rejected, s.solves, s.factorisations, s.cg_solves);
+        }
+        for dt in [5e-4, 2.5e-4, 1e-4, 5e-5, 2.5e-5, 1e-5, 5e-6, 2.5e-6, 1e-6] {
+            let mut theta = model.theta0.clone();
+            let mut st = Implicit::new(&model, scheme, Options::default()).unwrap();
+            let mut e = Vec::new();
+            let mut k = 0;
+            st.run(&mut theta, 0.0, dt, &outputs, |_, _, th, _| { e.push(max_diff(&th[..model.cloud.n_body], &reference[k])); k += 1; Ok(()) }, |_| {}).unwrap();
+            println!("jump fixed {scheme:?} dt {dt:e}: err {:?} solves {}", e.iter().map(|v| format!("{v:.2e}")).collect::<Vec<_>>(), st.stats.solves);
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn explore_steps() {
+    let case = bar(
+        "type = \"temperature\"\nmethod = \"mirror\"\nvalue = 1.0",
+        "type = \"insulated\"",
+        "0",
+    );
+    let model = Model::build(&case.spec).unwrap();
+    let mut theta = model.theta0.clone();
+    let mut st = Implicit::new(&model, Scheme::CrankNicolson, Options::default()).unwrap();
+    let a = Adaptive { tolerance: 1e-5, first: None, max: None };
+    let mut last = 0.0;
+    st.run_adaptive(&mut theta, 0.0, &a, &[0.01], |_, _, _, _| Ok(()), |s, t| { println!("{s} t {t:.3e} h {:.3e}", t - last); last = t; }).unwrap();
 }
