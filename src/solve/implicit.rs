@@ -515,6 +515,8 @@ enum Guess {
     Preset,
 }
 
+/// Share of the tolerance allowed to the error of a CG solution in adaptive runs.
+const CG_SHARE: f64 = 1e-3;
 /// Safety factor of the step controller (dimensionless).
 const SAFETY: f64 = 0.9;
 /// Accepted steps on a rung before the step may grow to the next (hysteresis).
@@ -567,6 +569,10 @@ pub struct Implicit<'a> {
     last_factor_seconds: f64,
     /// Seconds of all CG solves.
     cg_seconds: f64,
+    /// Error allowed to a CG solution, K (adaptive runs: [`CG_SHARE`] of the tolerance).
+    cg_error: f64,
+    /// Smallest heat capacity M_i, J/K.
+    min_mass: f64,
     /// Counters and timings.
     pub stats: ImplicitStats,
 }
@@ -663,6 +669,8 @@ impl<'a> Implicit<'a> {
             rent: Vec::with_capacity(RENT_SLOTS),
             last_factor_seconds: 0.0,
             cg_seconds: 0.0,
+            cg_error: 0.0,
+            min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,
             sys,
         })
@@ -855,7 +863,10 @@ impl<'a> Implicit<'a> {
             *ri += bi;
         }
         let bnorm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let tol = self.options.cg_tolerance * bnorm.max(f64::MIN_POSITIVE);
+        // relative residual, or (adaptive runs) ‖r‖₂ ≤ e·c·min M, which bounds the error
+        // ‖x − x*‖₂ ≤ ‖r‖₂/λ_min(cM + A) ≤ e since A is positive semi-definite
+        let tol = (self.options.cg_tolerance * bnorm.max(f64::MIN_POSITIVE))
+            .max(self.cg_error * c * self.min_mass);
         let diag = |k: usize| sys.vals[sys.diag_pos[k]] + c * sys.mass[k];
         for (k, (zi, ri)) in z.iter_mut().zip(r.iter()).enumerate() {
             *zi = ri / diag(k);
@@ -1263,6 +1274,7 @@ impl<'a> Implicit<'a> {
             ));
         }
         let n = self.sys.len();
+        self.cg_error = CG_SHARE * tol;
         for v in [
             &mut self.u_prev2,
             &mut self.next,
