@@ -1260,7 +1260,8 @@ impl CaseFile {
             if materials.iter().any(|m| m.phase_change.is_some()) {
                 return Err(err(
                     "time.tolerance",
-                    "adaptive steps need a linear material; phase change is integrated by euler".into(),
+                    "adaptive steps need a linear material; phase change is integrated by euler"
+                        .into(),
                 ));
             }
         }

@@ -562,7 +562,10 @@ fn adaptive_steps_pay_after_a_boundary_jump() {
         )
         .unwrap();
         let ef = worst(&fields, &reference);
-        println!("fixed Δt {dt:e}: error {ef:.3e}, {} solves", st.stats.solves);
+        println!(
+            "fixed Δt {dt:e}: error {ef:.3e}, {} solves",
+            st.stats.solves
+        );
         if ef <= e {
             fixed = Some(st.stats.solves);
             break;
@@ -626,18 +629,73 @@ fn adaptive_keys_are_checked() {
     );
     let phase = "[material.m.phase_change]\ntemperature = 0.5\nlatent_heat = 10.0\nfrozen_conductivity = 1.0\nfrozen_specific_heat = 1.0\n";
     for (time, material, key, words) in [
-        ("integrator = \"crank_nicolson\"\ntolerance = 0.0", "", "time.tolerance", "positive"),
-        ("integrator = \"crank_nicolson\"\ntolerance = -1e-3", "", "time.tolerance", "positive"),
-        ("integrator = \"crank_nicolson\"\ntolerance = nan", "", "time.tolerance", "positive"),
-        ("integrator = \"crank_nicolson\"\ntolerance = inf", "", "time.tolerance", "positive"),
-        ("integrator = \"euler\"\ntolerance = 1e-3", "", "time.tolerance", "not of euler"),
-        ("integrator = \"rk4\"\ntolerance = 1e-3", "", "time.tolerance", "not of rk4"),
+        (
+            "integrator = \"crank_nicolson\"\ntolerance = 0.0",
+            "",
+            "time.tolerance",
+            "positive",
+        ),
+        (
+            "integrator = \"crank_nicolson\"\ntolerance = -1e-3",
+            "",
+            "time.tolerance",
+            "positive",
+        ),
+        (
+            "integrator = \"crank_nicolson\"\ntolerance = nan",
+            "",
+            "time.tolerance",
+            "positive",
+        ),
+        (
+            "integrator = \"crank_nicolson\"\ntolerance = inf",
+            "",
+            "time.tolerance",
+            "positive",
+        ),
+        (
+            "integrator = \"euler\"\ntolerance = 1e-3",
+            "",
+            "time.tolerance",
+            "not of euler",
+        ),
+        (
+            "integrator = \"rk4\"\ntolerance = 1e-3",
+            "",
+            "time.tolerance",
+            "not of rk4",
+        ),
         ("tolerance = 1e-3", "", "time.tolerance", "not of rk4"),
-        ("integrator = \"steady\"\ntolerance = 1e-3", "", "time.tolerance", "not of steady"),
-        ("integrator = \"backward_euler\"\ntolerance = 1e-3", phase, "time.tolerance", "phase change"),
-        ("integrator = \"bdf2\"\ndt = 0.01\ndt_max = 0.1", "", "time.dt_max", "time.tolerance"),
-        ("integrator = \"bdf2\"\ntolerance = 1e-3\ndt_max = 0.0", "", "time.dt_max", "positive"),
-        ("integrator = \"bdf2\"\ntolerance = 1e-3\ndt = 0.2\ndt_max = 0.1", "", "time.dt", "exceeds"),
+        (
+            "integrator = \"steady\"\ntolerance = 1e-3",
+            "",
+            "time.tolerance",
+            "not of steady",
+        ),
+        (
+            "integrator = \"backward_euler\"\ntolerance = 1e-3",
+            phase,
+            "time.tolerance",
+            "phase change",
+        ),
+        (
+            "integrator = \"bdf2\"\ndt = 0.01\ndt_max = 0.1",
+            "",
+            "time.dt_max",
+            "time.tolerance",
+        ),
+        (
+            "integrator = \"bdf2\"\ntolerance = 1e-3\ndt_max = 0.0",
+            "",
+            "time.dt_max",
+            "positive",
+        ),
+        (
+            "integrator = \"bdf2\"\ntolerance = 1e-3\ndt = 0.2\ndt_max = 0.1",
+            "",
+            "time.dt",
+            "exceeds",
+        ),
     ] {
         let e = Case::parse(&text(time, material), Path::new("bad.toml"))
             .unwrap_err()

@@ -569,6 +569,8 @@ pub struct Implicit<'a> {
     last_factor_seconds: f64,
     /// Seconds of all CG solves.
     cg_seconds: f64,
+    /// Seconds of the last direct solve (0 before the first).
+    direct_seconds: f64,
     /// Error allowed to a CG solution, K (adaptive runs: [`CG_SHARE`] of the tolerance).
     cg_error: f64,
     /// Smallest heat capacity M_i, J/K.
@@ -669,6 +671,7 @@ impl<'a> Implicit<'a> {
             rent: Vec::with_capacity(RENT_SLOTS),
             last_factor_seconds: 0.0,
             cg_seconds: 0.0,
+            direct_seconds: 0.0,
             cg_error: 0.0,
             min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,
@@ -683,11 +686,7 @@ impl<'a> Implicit<'a> {
 
     /// Makes sure a factorisation of `cM + A` is cached; returns its slot.
     fn factor(&mut self, c: f64) -> Result<usize> {
-        if let Some(p) = self
-            .factors
-            .iter()
-            .position(|(k, _)| Self::same(*k, c))
-        {
+        if let Some(p) = self.factors.iter().position(|(k, _)| Self::same(*k, c)) {
             return Ok(p);
         }
         let started = Instant::now();
@@ -755,10 +754,11 @@ impl<'a> Implicit<'a> {
         (k - c).abs() <= 1e-12 * c.abs().max(f64::MIN_POSITIVE)
     }
 
-    /// [`Solver::Auto`]: solve with CG while the CG seconds spent on `c` are below the cost of
-    /// one factorisation, then factorise (the ski-rental rule: at most twice the cheaper
-    /// choice's cost). The cost is the last factorisation's time; before any, CG iterations
-    /// scaled by the factor's fill ([`FACTOR_PER_FILL`]).
+    /// [`Solver::Auto`]: solve with CG while the seconds its solves on `c` took beyond a direct
+    /// solve (the last one timed; 0 before any) are below the cost of one factorisation, then
+    /// factorise (the ski-rental rule: at most twice the cheaper choice's cost). The cost is
+    /// the last factorisation's time; before any, CG iterations scaled by the factor's fill
+    /// ([`FACTOR_PER_FILL`]). So CG stays wherever it is cheaper per solve than the factor.
     fn use_cg(&self, c: f64) -> bool {
         match self.options.solver {
             Solver::Cg => true,
@@ -789,9 +789,10 @@ impl<'a> Implicit<'a> {
         }
     }
 
-    /// Adds CG seconds spent on coefficient c ([`Solver::Auto`]).
+    /// Adds what a CG solve on coefficient c cost beyond a direct solve ([`Solver::Auto`]).
     fn pay_rent(&mut self, c: f64, seconds: f64) {
         self.cg_seconds += seconds;
+        let seconds = (seconds - self.direct_seconds).max(0.0);
         if let Some(r) = self.rent.iter_mut().find(|(k, _)| Self::same(*k, c)) {
             r.1 += seconds;
             return;
@@ -843,7 +844,8 @@ impl<'a> Implicit<'a> {
             }
         }
         self.stats.solves += 1;
-        self.stats.solve_seconds += started.elapsed().as_secs_f64();
+        self.direct_seconds = started.elapsed().as_secs_f64();
+        self.stats.solve_seconds += self.direct_seconds;
         Ok(())
     }
 
@@ -1067,11 +1069,17 @@ impl<'a> Implicit<'a> {
         }
     }
 
-    /// `rhs = c·M·v + Σ extra` helper: `rhs = c·M·v + f_next`.
+    /// `rhs = c·M·v + f_next` (W) with v = `next` or `u`.
     fn rhs_mass(&mut self, c: f64, from_next: bool) {
         let v = if from_next { &self.next } else { &self.u };
-        for r in 0..v.len() {
-            self.rhs[r] = c * self.sys.mass[r] * v[r] + self.f_next[r];
+        for (((o, vr), m), f) in self
+            .rhs
+            .iter_mut()
+            .zip(v)
+            .zip(&self.sys.mass)
+            .zip(&self.f_next)
+        {
+            *o = c * m * vr + f;
         }
     }
 
@@ -1144,8 +1152,8 @@ impl<'a> Implicit<'a> {
             Scheme::CrankNicolson => {
                 let w = h / h_prev;
                 for r in 0..n {
-                    self.pred[r] = self.u[r]
-                        + 0.5 * h * ((2.0 + w) * self.d_now[r] - w * self.d_prev[r]);
+                    self.pred[r] =
+                        self.u[r] + 0.5 * h * ((2.0 + w) * self.d_now[r] - w * self.d_prev[r]);
                 }
                 self.forcing_into_next(t1);
                 // (2M/h + A)θₙ₊₁ = (2M/h − A)θₙ + fₙ + fₙ₊₁ = 2M/h θₙ + M θ'ₙ + fₙ₊₁
@@ -1339,7 +1347,8 @@ impl<'a> Implicit<'a> {
             } else {
                 f64::INFINITY
             };
-            if !(est <= tol) {
+            let accepted = est <= tol;
+            if !accepted {
                 // rejected (or non-finite): drop rungs and retry from the same state
                 self.stats.rejected += 1;
                 on_rung = 0;
