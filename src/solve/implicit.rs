@@ -37,6 +37,11 @@
 //! and it damps the stiff modes that a discontinuous start, e.g. a boundary jump, excites);
 //! BDF2 with variable-step coefficients (ω = h_n/h_{n−1}), started by one backward-Euler step.
 //! Steady: `A θ = f(t)` at each output time's boundary data.
+//!
+//! **Adaptive Δt** ([`Implicit::run_adaptive`], case key `time.tolerance`): a local error
+//! estimate per step (backward Euler from θ', Crank–Nicolson TR–AB2, BDF2 Milne; see
+//! `Implicit::attempt`), steps on a ladder h_max·2^(−k) so that each matrix is factorised
+//! once, [`Solver::Auto`] (CG on a rung until factorising pays) and cubic Hermite output.
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -1241,20 +1246,20 @@ impl<'a> Implicit<'a> {
         self.pred.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
     }
 
-    /// Integrates from `t0` with steps chosen from a local error estimate (see [`Self::attempt`])
-    /// and calls `on_output(k, t, θ, K)` at each output time with θ there from the cubic
-    /// Hermite interpolant of the step that covers it (θ and θ' at both ends: fourth-order
-    /// accurate, so the steps need not land on the outputs); `progress(accepted, t)` after each
-    /// accepted step.
+    /// Integrates from `t0` with steps chosen from a local error estimate (see
+    /// `Implicit::attempt`) and calls `on_output(k, t, θ, K)` at each output time with θ there
+    /// from the cubic Hermite interpolant of the step that covers it (θ and θ' at both ends:
+    /// fourth-order accurate, so the steps need not land on the outputs); `progress(accepted,
+    /// t)` after each accepted step.
     ///
     /// **Step control.** Steps are rungs h_k = h_max·2^(−k) of a ladder so that each distinct
     /// matrix cM + A is factorised once and reused (two factorisations cached). A step is
     /// accepted when est ≤ tol; the ideal next step is h·0.9·(tol/est)^(1/(p+1)). On
-    /// acceptance the step climbs one rung when that ideal is at least twice the step and
-    /// [`HYSTERESIS`] steps were accepted on the rung; on rejection it drops as many rungs as
-    /// the ideal asks (at least one, at most [`MAX_CUT`]) and retries from the same state.
-    /// The first step is the largest rung not above `first`. The last step may pass the last
-    /// output time.
+    /// acceptance the step climbs one rung when that ideal is at least twice the step and 3
+    /// steps were accepted on the rung (two rungs after one step when it is 4× or more; BDF2
+    /// one rung after two steps); on rejection it drops as many rungs as the ideal asks (at
+    /// least one, at most five) and retries from the same state. The first step is the
+    /// largest rung not above `first`. The last step may pass the last output time.
     pub fn run_adaptive(
         &mut self,
         theta: &mut [f64],
