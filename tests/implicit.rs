@@ -729,3 +729,30 @@ fn adaptive_run_reports_its_counters() {
     assert_eq!(summary.dt, st.first_step);
     assert_eq!(read.fields.len(), 2);
 }
+
+/// The automatic solver choice against the direct solver alone on the adaptive crack plate
+/// (prints wall time, solves and factorisations; run with `--ignored --nocapture`; ~1 min).
+#[test]
+#[ignore]
+fn adaptive_auto_vs_direct() {
+    let case = Case::load(Path::new("cases/dh_crack_plate_k1_m1_adaptive.toml")).unwrap();
+    let model = Model::build(&case.spec).unwrap();
+    for solver in [Solver::Auto, Solver::Direct] {
+        let o = Options {
+            solver,
+            ..Options::default()
+        };
+        let started = std::time::Instant::now();
+        let (_, s) = adaptive(&model, Scheme::CrankNicolson, 1e-3, &case.outputs, o);
+        println!(
+            "{solver:?}: {:.2} s, {} steps, {} solves ({} by CG, {} iterations), {} factorisations ({:.2} s)",
+            started.elapsed().as_secs_f64(),
+            s.accepted,
+            s.solves,
+            s.cg_solves,
+            s.cg_iterations,
+            s.factorisations,
+            s.factor_seconds
+        );
+    }
+}
