@@ -314,6 +314,13 @@ pub struct TimeSpec {
     /// Output times, s (default: the end time).
     #[serde(default)]
     pub outputs: Vec<f64>,
+    /// Adaptive Δt of the implicit schemes: local error allowed per step, max over the
+    /// unknowns, K (default: none, fixed Δt).
+    #[serde(default)]
+    pub tolerance: Option<f64>,
+    /// Largest adaptive step, s (default: a tenth of the last output time).
+    #[serde(default)]
+    pub dt_max: Option<f64>,
 }
 
 /// `[reference]` as written: one classical solution and where to compare.
@@ -398,8 +405,12 @@ pub struct Case {
     pub spec: ModelSpec,
     /// Integrator.
     pub integrator: Integrator,
-    /// User Δt, s.
+    /// User Δt, s (with `tolerance`: the first step).
     pub dt: Option<f64>,
+    /// Local error allowed per adaptive step, K (None: fixed Δt).
+    pub tolerance: Option<f64>,
+    /// Largest adaptive step, s (None: a tenth of the last output time).
+    pub dt_max: Option<f64>,
     /// End time, s.
     pub end: f64,
     /// Output times, s, increasing.
@@ -1232,6 +1243,43 @@ impl CaseFile {
                 } else {
                     Integrator::Rk4
                 });
+        if let Some(tol) = self.time.tolerance {
+            positive(path, "time.tolerance", tol)?;
+            if !matches!(
+                integrator,
+                Integrator::BackwardEuler | Integrator::CrankNicolson | Integrator::Bdf2
+            ) {
+                return Err(err(
+                    "time.tolerance",
+                    format!(
+                        "adaptive steps are an option of backward_euler, crank_nicolson and bdf2, not of {}",
+                        integrator.name()
+                    ),
+                ));
+            }
+            if materials.iter().any(|m| m.phase_change.is_some()) {
+                return Err(err(
+                    "time.tolerance",
+                    "adaptive steps need a linear material; phase change is integrated by euler"
+                        .into(),
+                ));
+            }
+        }
+        if let Some(h) = self.time.dt_max {
+            positive(path, "time.dt_max", h)?;
+            if self.time.tolerance.is_none() {
+                return Err(err(
+                    "time.dt_max",
+                    "bounds adaptive steps only: give time.tolerance too".into(),
+                ));
+            }
+            if let Some(dt) = self.time.dt.filter(|&dt| dt > h) {
+                return Err(err(
+                    "time.dt",
+                    format!("the first adaptive step {dt} exceeds time.dt_max = {h}"),
+                ));
+            }
+        }
         Ok(Case {
             path: path.to_path_buf(),
             title: self.title,
@@ -1250,6 +1298,8 @@ impl CaseFile {
             },
             integrator,
             dt: self.time.dt,
+            tolerance: self.time.tolerance,
+            dt_max: self.time.dt_max,
             end,
             outputs,
             reference,

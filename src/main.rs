@@ -223,6 +223,18 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 summary.wall_seconds,
                 out.display()
             );
+            if let Some(st) = &summary.implicit {
+                say!(
+                    "  {} accepted and {} rejected steps ({:.3e} to {:.3e} s), {} solves ({} by CG), {} factorisations",
+                    st.accepted,
+                    st.rejected,
+                    st.min_step,
+                    st.max_step,
+                    st.solves,
+                    st.cg_solves,
+                    st.factorisations
+                );
+            }
             print_comparisons(&summary);
             Ok(())
         }

@@ -343,6 +343,9 @@ pub struct RunSummary {
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,
+    /// Implicit runs: solves, factorisations, accepted and rejected steps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub implicit: Option<crate::solve::implicit::ImplicitStats>,
 }
 
 fn peridynamics() -> String {

@@ -12,7 +12,7 @@ use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
 use crate::solve::enthalpy::Enthalpic;
 use crate::solve::explicit::{choose_dt, count_steps, Explicit, Integrator};
-use crate::solve::implicit::{Implicit, Options, Scheme};
+use crate::solve::implicit::{Adaptive, Implicit, Options, Scheme, Solver};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -52,7 +52,16 @@ pub fn run_model(
         },
         other => other,
     };
-    let dt = choose_dt(&model, case.integrator, case.dt).map_err(in_case)?;
+    let adaptive = case.tolerance.map(|tolerance| Adaptive {
+        tolerance,
+        first: case.dt,
+        max: case.dt_max,
+    });
+    // adaptive runs: dt is the first step (None: chosen from the tolerance)
+    let dt = match adaptive {
+        Some(_) => case.dt.unwrap_or(0.0),
+        None => choose_dt(&model, case.integrator, case.dt).map_err(in_case)?,
+    };
     let scheme = match case.integrator {
         Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
         Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
@@ -66,7 +75,17 @@ pub fn run_model(
     };
     // the implicit system (elimination, symbolic factorisation) is part of the set-up
     let mut implicit = match scheme {
-        Some(s) => Some(Implicit::new(&model, s, Options::default()).map_err(in_case)?),
+        Some(s) => {
+            // adaptive steps visit several Δt: CG until a factorisation pays (Solver::Auto)
+            let options = Options {
+                solver: match adaptive {
+                    Some(_) => Solver::Auto,
+                    None => Solver::Direct,
+                },
+                ..Options::default()
+            };
+            Some(Implicit::new(&model, s, options).map_err(in_case)?)
+        }
         None => None,
     };
     let setup_seconds = t_setup.elapsed().as_secs_f64();
@@ -74,7 +93,7 @@ pub fn run_model(
         path: out.to_path_buf(),
         error,
     })?;
-    let total = if case.integrator == Integrator::Steady {
+    let total = if case.integrator == Integrator::Steady || adaptive.is_some() {
         0
     } else {
         count_steps(0.0, &case.outputs, dt)
@@ -138,6 +157,19 @@ pub fn run_model(
         (None, Some(stepper)) if case.integrator == Integrator::Steady => {
             stepper.steady(&mut theta, &case.outputs, linear_output)
         }
+        (None, Some(stepper)) if adaptive.is_some() => {
+            let adaptive = adaptive.as_ref().expect("adaptive");
+            let t_last = case.outputs.last().copied().unwrap_or(case.end);
+            stepper.run_adaptive(
+                &mut theta,
+                0.0,
+                adaptive,
+                &case.outputs,
+                linear_output,
+                // the number of steps is not known: extrapolate it from the time reached
+                |s, t| progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64),
+            )
+        }
         (None, Some(stepper)) => {
             stepper.run(&mut theta, 0.0, dt, &case.outputs, linear_output, |s| {
                 progress(s, total)
@@ -175,8 +207,13 @@ pub fn run_model(
         bonds: model.horizons.n_bonds(),
         pairs: model.conductance.nnz(),
         steps: stats.steps,
-        // implicit runs: the step taken (0 for steady) and, for comparison, Euler's bound
-        dt: if dt.is_finite() { dt } else { 0.0 },
+        // implicit runs: the step taken (adaptive: the first; 0 for steady) and, for
+        // comparison, Euler's bound
+        dt: match (&implicit, adaptive) {
+            (Some(st), Some(_)) => st.stats.first_step,
+            _ if dt.is_finite() => dt,
+            _ => 0.0,
+        },
         dt_stable: if case.integrator.is_implicit() {
             Integrator::Euler.stable_dt(&model)
         } else {
@@ -195,6 +232,7 @@ pub fn run_model(
             .correction
             .map(|c| [c.before, c.after, c.iterations as f64, c.min_ratio]),
         reference: comparisons,
+        implicit: implicit.as_ref().map(|st| st.stats),
     };
     summary.write(out)?;
     Ok(summary)

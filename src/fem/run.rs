@@ -391,6 +391,7 @@ pub fn run_fem(
         threads: rayon::current_num_threads(),
         consistency: None,
         reference: comparisons,
+        implicit: None,
     };
     summary.write(out)?;
     Ok(summary)

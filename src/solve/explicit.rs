@@ -86,7 +86,7 @@ pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Re
             None => Err(Error::model(
                 "time.dt",
                 format!(
-                    "is required for the implicit integrator {} (no stability bound to default to)",
+                    "is required for the implicit integrator {} (no stability bound to default to), unless time.tolerance asks for adaptive steps",
                     integrator.name()
                 ),
             )),

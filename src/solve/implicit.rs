@@ -37,6 +37,11 @@
 //! and it damps the stiff modes that a discontinuous start, e.g. a boundary jump, excites);
 //! BDF2 with variable-step coefficients (ω = h_n/h_{n−1}), started by one backward-Euler step.
 //! Steady: `A θ = f(t)` at each output time's boundary data.
+//!
+//! **Adaptive Δt** ([`Implicit::run_adaptive`], case key `time.tolerance`): a local error
+//! estimate per step (backward Euler from θ', Crank–Nicolson TR–AB2, BDF2 Milne; see
+//! `Implicit::attempt`), steps on a ladder h_max·2^(−k) so that each matrix is factorised
+//! once, [`Solver::Auto`] (CG on a rung until factorising pays) and cubic Hermite output.
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -52,6 +57,7 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, Symbolic
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// Implicit time-stepping scheme (formulation §4).
@@ -72,6 +78,9 @@ pub enum Solver {
     Direct,
     /// Jacobi-preconditioned conjugate gradients (symmetric A only), warm-started.
     Cg,
+    /// Direct, but a coefficient c not factorised yet is solved by Jacobi-PCG until the CG time
+    /// spent on it exceeds one factorisation (ski rental; symmetric A, else as `Direct`).
+    Auto,
 }
 
 /// Fill-reducing ordering of the sparse Cholesky factorisation.
@@ -450,16 +459,18 @@ pub fn nested_dissection(sys: &System, model: &Model) -> (Vec<usize>, Vec<usize>
 enum Factor {
     Llt(Vec<f64>),
     Lu(Box<NumericLu<usize, f64>>),
-    Cg,
 }
 
-/// Counters and timings of an implicit run.
-#[derive(Debug, Clone, Copy, Default)]
+/// Counters and timings of an implicit run (run.json `implicit`).
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 pub struct ImplicitStats {
     /// Numeric factorisations performed.
     pub factorisations: u64,
-    /// Linear solves performed.
+    /// Linear solves performed (direct and CG).
     pub solves: u64,
+    /// Linear solves done by conjugate gradients.
+    #[serde(default)]
+    pub cg_solves: u64,
     /// Conjugate-gradient iterations in all (0 for the direct solver).
     pub cg_iterations: u64,
     /// Seconds spent in symbolic and numeric factorisation, s.
@@ -468,7 +479,64 @@ pub struct ImplicitStats {
     pub solve_seconds: f64,
     /// Stored entries of the Cholesky factor L (0 for LU and CG).
     pub factor_entries: usize,
+    /// Adaptive runs: local error allowed per step, K (0 for fixed Δt).
+    #[serde(default)]
+    pub tolerance: f64,
+    /// Steps accepted (all steps for fixed Δt).
+    #[serde(default)]
+    pub accepted: u64,
+    /// Adaptive steps rejected by the error estimate and retried shorter.
+    #[serde(default)]
+    pub rejected: u64,
+    /// First accepted step, s.
+    #[serde(default)]
+    pub first_step: f64,
+    /// Shortest accepted step, s.
+    #[serde(default)]
+    pub min_step: f64,
+    /// Longest accepted step, s.
+    #[serde(default)]
+    pub max_step: f64,
 }
+
+/// Adaptive Δt of [`Implicit::run_adaptive`].
+#[derive(Debug, Clone, Copy)]
+pub struct Adaptive {
+    /// Local error estimate allowed per step, max over the unknowns, K.
+    pub tolerance: f64,
+    /// First step, s (None: tolerance over the largest initial rate |θ'(0)|, or a
+    /// ten-thousandth of the last output time if nothing moves at t0).
+    pub first: Option<f64>,
+    /// Largest step, the top of the ladder, s (None: a tenth of the last output time).
+    pub max: Option<f64>,
+}
+
+/// Initial guess of a conjugate-gradient solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Guess {
+    Zero,
+    U,
+    /// Already in the first CG buffer.
+    Preset,
+}
+
+/// Share of the tolerance allowed to the error of a CG solution in adaptive runs.
+const CG_SHARE: f64 = 1e-3;
+/// Safety factor of the step controller (dimensionless).
+const SAFETY: f64 = 0.9;
+/// Accepted steps on a rung before the step may grow to the next (hysteresis).
+const HYSTERESIS: u32 = 3;
+/// Most rungs one accepted step may climb (growth cap 2² = 4).
+const GROWTH_RUNGS: u32 = 2;
+/// Most rungs one rejection may go down (factor 2^−5).
+const MAX_CUT: u32 = 5;
+/// Most halvings of the ladder's top step before the run gives up.
+const MAX_RUNG: u32 = 60;
+/// Coefficients whose CG time is remembered by [`Solver::Auto`].
+const RENT_SLOTS: usize = 64;
+/// Before any factorisation is timed, [`Solver::Auto`] estimates one as this many CG
+/// iterations times nnz(L)/nnz(A) (measured: crack plate 1.0 s ≈ 17, thermal shock 6.9 s ≈ 9).
+const FACTOR_PER_FILL: f64 = 15.0;
 
 /// Implicit integrator state with preallocated buffers.
 pub struct Implicit<'a> {
@@ -491,6 +559,27 @@ pub struct Implicit<'a> {
     scratch: Vec<f64>,
     rate: Vec<f64>,
     cg: [Vec<f64>; 4],
+    /// Adaptive runs: θ two steps back, the next solution, θ' now / one step back / next
+    /// (K/s), the predictor and the BDF2 history value.
+    u_prev2: Vec<f64>,
+    next: Vec<f64>,
+    d_now: Vec<f64>,
+    d_prev: Vec<f64>,
+    d_next: Vec<f64>,
+    pred: Vec<f64>,
+    hist: Vec<f64>,
+    /// [`Solver::Auto`]: CG seconds spent per coefficient c not factorised.
+    rent: Vec<(f64, f64)>,
+    /// Seconds of the last numeric factorisation (0 before the first).
+    last_factor_seconds: f64,
+    /// Seconds of all CG solves.
+    cg_seconds: f64,
+    /// Seconds of the last direct solve (0 before the first).
+    direct_seconds: f64,
+    /// Error allowed to a CG solution, K (adaptive runs: [`CG_SHARE`] of the tolerance).
+    cg_error: f64,
+    /// Smallest heat capacity M_i, J/K.
+    min_mass: f64,
     /// Counters and timings.
     pub stats: ImplicitStats,
 }
@@ -515,7 +604,7 @@ impl<'a> Implicit<'a> {
         let t = Instant::now();
         let (chol, lu, stack) = match options.solver {
             Solver::Cg => (None, None, MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
-            Solver::Direct if sys.symmetric => {
+            Solver::Direct | Solver::Auto if sys.symmetric => {
                 let (fwd, inv) = match options.ordering {
                     Ordering::NestedDissection => nested_dissection(&sys, model),
                     Ordering::Amd => (Vec::new(), Vec::new()),
@@ -538,7 +627,7 @@ impl<'a> Implicit<'a> {
                 let req = s.solve_in_place_scratch::<f64>(1, par);
                 (Some(s), None, MemBuffer::new(req))
             }
-            Solver::Direct => {
+            Solver::Direct | Solver::Auto => {
                 let s = factorize_symbolic_lu(symbolic, Default::default()).map_err(|e| {
                     Error::Solver {
                         message: format!("symbolic LU: {e:?}"),
@@ -577,6 +666,19 @@ impl<'a> Implicit<'a> {
             scratch,
             rate: vec![0.0; model.cloud.n_body],
             cg: std::array::from_fn(|_| vec![0.0; n]),
+            u_prev2: Vec::new(),
+            next: Vec::new(),
+            d_now: Vec::new(),
+            d_prev: Vec::new(),
+            d_next: Vec::new(),
+            pred: Vec::new(),
+            hist: Vec::new(),
+            rent: Vec::with_capacity(RENT_SLOTS),
+            last_factor_seconds: 0.0,
+            cg_seconds: 0.0,
+            direct_seconds: 0.0,
+            cg_error: 0.0,
+            min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,
             sys,
         })
@@ -589,11 +691,7 @@ impl<'a> Implicit<'a> {
 
     /// Makes sure a factorisation of `cM + A` is cached; returns its slot.
     fn factor(&mut self, c: f64) -> Result<usize> {
-        if let Some(p) = self
-            .factors
-            .iter()
-            .position(|(k, _)| (k - c).abs() <= 1e-12 * c.abs().max(f64::MIN_POSITIVE))
-        {
+        if let Some(p) = self.factors.iter().position(|(k, _)| Self::same(*k, c)) {
             return Ok(p);
         }
         let started = Instant::now();
@@ -642,22 +740,87 @@ impl<'a> Implicit<'a> {
             })?;
             Factor::Lu(Box::new(numeric))
         } else {
-            // conjugate gradients: keep the matrix values per coefficient implicitly
-            Factor::Cg
+            return Err(Error::Solver {
+                message: "no symbolic factorisation for the direct solver".into(),
+            });
         };
         if self.factors.len() == 2 {
             self.factors.remove(0);
         }
         self.factors.push((c, factor));
-        if !matches!(self.factors.last(), Some((_, Factor::Cg))) {
-            self.stats.factorisations += 1;
-        }
-        self.stats.factor_seconds += started.elapsed().as_secs_f64();
+        self.stats.factorisations += 1;
+        self.last_factor_seconds = started.elapsed().as_secs_f64();
+        self.stats.factor_seconds += self.last_factor_seconds;
         Ok(self.factors.len() - 1)
     }
 
+    /// True when `c` matches `k` to 1e-12 relative.
+    fn same(k: f64, c: f64) -> bool {
+        (k - c).abs() <= 1e-12 * c.abs().max(f64::MIN_POSITIVE)
+    }
+
+    /// [`Solver::Auto`]: solve with CG while the seconds its solves on `c` took beyond a direct
+    /// solve (the last one timed; 0 before any) are below the cost of one factorisation, then
+    /// factorise (the ski-rental rule: at most twice the cheaper choice's cost). The cost is
+    /// the last factorisation's time; before any, CG iterations scaled by the factor's fill
+    /// ([`FACTOR_PER_FILL`]). So CG stays wherever it is cheaper per solve than the factor.
+    fn use_cg(&self, c: f64) -> bool {
+        match self.options.solver {
+            Solver::Cg => true,
+            Solver::Direct => false,
+            Solver::Auto => {
+                let Some(chol) = &self.chol else {
+                    return false;
+                };
+                if self.factors.iter().any(|(k, _)| Self::same(*k, c)) {
+                    return false;
+                }
+                let spent = self
+                    .rent
+                    .iter()
+                    .find(|(k, _)| Self::same(*k, c))
+                    .map_or(0.0, |r| r.1);
+                let cost = if self.last_factor_seconds > 0.0 {
+                    self.last_factor_seconds
+                } else if self.stats.cg_iterations > 0 {
+                    let per_iteration = self.cg_seconds / self.stats.cg_iterations as f64;
+                    let fill = chol.len_val() as f64 / self.sys.vals.len() as f64;
+                    FACTOR_PER_FILL * fill * per_iteration
+                } else {
+                    f64::INFINITY
+                };
+                spent < cost
+            }
+        }
+    }
+
+    /// Adds what a CG solve on coefficient c cost beyond a direct solve ([`Solver::Auto`]).
+    fn pay_rent(&mut self, c: f64, seconds: f64) {
+        self.cg_seconds += seconds;
+        let seconds = (seconds - self.direct_seconds).max(0.0);
+        if let Some(r) = self.rent.iter_mut().find(|(k, _)| Self::same(*k, c)) {
+            r.1 += seconds;
+            return;
+        }
+        if self.rent.len() == RENT_SLOTS {
+            self.rent.remove(0);
+        }
+        self.rent.push((c, seconds));
+    }
+
     /// Solves `(cM + A) x = rhs`: the answer replaces `rhs`; `guess` starts CG.
-    fn solve(&mut self, c: f64, guess_is_u: bool) -> Result<()> {
+    fn solve(&mut self, c: f64, guess: Guess) -> Result<()> {
+        if self.use_cg(c) {
+            let started = Instant::now();
+            let its = self.pcg(c, guess)?;
+            let seconds = started.elapsed().as_secs_f64();
+            self.pay_rent(c, seconds);
+            self.stats.cg_iterations += its;
+            self.stats.cg_solves += 1;
+            self.stats.solves += 1;
+            self.stats.solve_seconds += seconds;
+            return Ok(());
+        }
         let slot = self.factor(c)?;
         let started = Instant::now();
         let n = self.sys.len();
@@ -684,25 +847,22 @@ impl<'a> Implicit<'a> {
                     MemStack::new(&mut self.stack),
                 );
             }
-            Factor::Cg => {
-                let its = self.pcg(c, guess_is_u)?;
-                self.stats.cg_iterations += its;
-            }
         }
         self.stats.solves += 1;
-        self.stats.solve_seconds += started.elapsed().as_secs_f64();
+        self.direct_seconds = started.elapsed().as_secs_f64();
+        self.stats.solve_seconds += self.direct_seconds;
         Ok(())
     }
 
     /// Jacobi-preconditioned CG on `(cM + A) x = rhs`; x replaces `rhs`. Returns iterations.
-    fn pcg(&mut self, c: f64, guess_is_u: bool) -> Result<u64> {
+    fn pcg(&mut self, c: f64, guess: Guess) -> Result<u64> {
         let sys = &self.sys;
         let par = self.options.parallel;
         let [x, r, z, p] = &mut self.cg;
-        if guess_is_u {
-            x.copy_from_slice(&self.u);
-        } else {
-            x.fill(0.0);
+        match guess {
+            Guess::U => x.copy_from_slice(&self.u),
+            Guess::Zero => x.fill(0.0),
+            Guess::Preset => {}
         }
         // r = b − B x, with B = cM + A = −(−c M − A)
         sys.combine(-c, 1.0, x, r, par);
@@ -710,7 +870,10 @@ impl<'a> Implicit<'a> {
             *ri += bi;
         }
         let bnorm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let tol = self.options.cg_tolerance * bnorm.max(f64::MIN_POSITIVE);
+        // relative residual, or (adaptive runs) ‖r‖₂ ≤ e·c·min M, which bounds the error
+        // ‖x − x*‖₂ ≤ ‖r‖₂/λ_min(cM + A) ≤ e since A is positive semi-definite
+        let tol = (self.options.cg_tolerance * bnorm.max(f64::MIN_POSITIVE))
+            .max(self.cg_error * c * self.min_mass);
         let diag = |k: usize| sys.vals[sys.diag_pos[k]] + c * sys.mass[k];
         for (k, (zi, ri)) in z.iter_mut().zip(r.iter()).enumerate() {
             *zi = ri / diag(k);
@@ -765,7 +928,7 @@ impl<'a> Implicit<'a> {
         for r in 0..self.u.len() {
             self.rhs[r] = c * self.sys.mass[r] * self.u[r] + self.f_next[r];
         }
-        self.solve(c, true)?;
+        self.solve(c, Guess::U)?;
         std::mem::swap(&mut self.u_prev, &mut self.u);
         std::mem::swap(&mut self.u, &mut self.rhs);
         Ok(())
@@ -780,7 +943,7 @@ impl<'a> Implicit<'a> {
         for r in 0..self.u.len() {
             self.rhs[r] += self.f_now[r] + self.f_next[r];
         }
-        self.solve(c, true)?;
+        self.solve(c, Guess::U)?;
         std::mem::swap(&mut self.u_prev, &mut self.u);
         std::mem::swap(&mut self.u, &mut self.rhs);
         std::mem::swap(&mut self.f_now, &mut self.f_next);
@@ -797,7 +960,7 @@ impl<'a> Implicit<'a> {
             self.rhs[r] =
                 self.sys.mass[r] / h * (a1 * self.u[r] - a2 * self.u_prev[r]) + self.f_next[r];
         }
-        self.solve(a0 / h, true)?;
+        self.solve(a0 / h, Guess::U)?;
         std::mem::swap(&mut self.u_prev, &mut self.u);
         std::mem::swap(&mut self.u, &mut self.rhs);
         Ok(())
@@ -877,13 +1040,389 @@ impl<'a> Implicit<'a> {
                 }
                 h_prev = h;
                 stats.steps += 1;
+                if stats.steps == 1 {
+                    self.stats.first_step = h;
+                    self.stats.min_step = h;
+                }
+                self.stats.min_step = self.stats.min_step.min(h);
+                self.stats.max_step = self.stats.max_step.max(h);
                 progress(stats.steps);
             }
             t = to;
             self.scatter(theta, t)?;
             on_output(k, t, theta, &self.model.conductance)?;
         }
+        self.stats.accepted = stats.steps;
         Ok(stats)
+    }
+
+    /// θ' = M⁻¹(f − A v) into `out` (K/s).
+    fn derivative(sys: &System, v: &[f64], f: &[f64], out: &mut [f64], parallel: bool) {
+        sys.combine(0.0, 1.0, v, out, parallel);
+        for ((o, fr), m) in out.iter_mut().zip(f).zip(&sys.mass) {
+            *o = (*o + fr) / m;
+        }
+    }
+
+    /// Cubic Hermite interpolant at s ∈ [0, 1] of a step of length h from (a, a') to (b, b').
+    fn hermite(a: &[f64], da: &[f64], b: &[f64], db: &[f64], h: f64, s: f64, out: &mut [f64]) {
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10) = (2.0 * s3 - 3.0 * s2 + 1.0, (s3 - 2.0 * s2 + s) * h);
+        let (h01, h11) = (3.0 * s2 - 2.0 * s3, (s3 - s2) * h);
+        for r in 0..out.len() {
+            out[r] = h00 * a[r] + h10 * da[r] + h01 * b[r] + h11 * db[r];
+        }
+    }
+
+    /// `rhs = c·M·v + f_next` (W) with v = `next` or `u`.
+    fn rhs_mass(&mut self, c: f64, from_next: bool) {
+        let v = if from_next { &self.next } else { &self.u };
+        for (((o, vr), m), f) in self
+            .rhs
+            .iter_mut()
+            .zip(v)
+            .zip(&self.sys.mass)
+            .zip(&self.f_next)
+        {
+            *o = c * m * vr + f;
+        }
+    }
+
+    /// One attempted step of length h from (t, u) to t + h; the result goes to `next` and
+    /// `d_next` (θ' there), f(t + h) to `f_next`. Returns the local error estimate (K, max
+    /// over the unknowns) and the order p it scales with (est ∝ h^(p+1)).
+    ///
+    /// Estimates: backward Euler `(h/2)·‖θ'ₙ₊₁ − θ'ₙ‖` (its local error h²θ''/2, θ'' by the
+    /// difference of the directly evaluated derivatives; Hairer & Wanner, *Solving ODEs II*,
+    /// §IV.8); Crank–Nicolson's Rannacher start (two backward-Euler half steps) the same at
+    /// half the weight, `(h/4)·‖θ'₁ − θ'₀‖`; Crank–Nicolson the TR–AB2 estimate of Gresho &
+    /// Sani (*Incompressible Flow and the FEM*, vol. 1, §3.16.4; Gresho, Griffiths & Silvester,
+    /// SIAM J. Sci. Comput. 30, 2008): AB2 predictor θᵖ = θₙ + (hₙ/2)[(2 + hₙ/hₙ₋₁)θ'ₙ −
+    /// (hₙ/hₙ₋₁)θ'ₙ₋₁] and dₙ₊₁ = (θₙ₊₁ − θᵖ)/(3(1 + hₙ₋₁/hₙ)), θ' = M⁻¹(f − Aθ) evaluated
+    /// directly; BDF2 Milne's device (Hairer, Nørsett & Wanner, *Solving ODEs I*, §III.7;
+    /// Brenan, Campbell & Petzold, *DAEs*, §5.2): the quadratic through the last three
+    /// accepted values extrapolated to tₙ₊₁ errs by C_p h³θ''', BDF2 by −(2/9)h³θ''', so the
+    /// local error is (2/9)/(C_p + 2/9)·‖θₙ₊₁ − θᵖ‖ (2/11 for equal steps).
+    ///
+    /// BDF2 here has a fixed leading coefficient, `(3/2)θₙ₊₁ − 2θₙ + (1/2)θ(tₙ − h) =
+    /// h M⁻¹(f − Aθₙ₊₁)`, with θ(tₙ − h) an accepted value or the Hermite interpolant of the
+    /// last step when the step changed (the interpolation strategy of Brenan, Campbell &
+    /// Petzold §5.2): its matrix 1.5M/h + A depends on h alone, so each rung of the ladder
+    /// has one factorisation.
+    #[allow(clippy::too_many_arguments)]
+    fn attempt(
+        &mut self,
+        accepted: u64,
+        t: f64,
+        h: f64,
+        h_prev: f64,
+        t_prev: f64,
+        t_prev2: f64,
+    ) -> Result<(f64, u32)> {
+        let par = self.options.parallel;
+        let n = self.u.len();
+        let t1 = t + h;
+        let first = accepted == 0;
+        match self.scheme {
+            Scheme::BackwardEuler | Scheme::Bdf2
+                if first || self.scheme == Scheme::BackwardEuler =>
+            {
+                self.forcing_into_next(t1);
+                self.rhs_mass(1.0 / h, false);
+                self.solve(1.0 / h, Guess::U)?;
+                std::mem::swap(&mut self.next, &mut self.rhs);
+                Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
+                for r in 0..n {
+                    self.pred[r] = 0.5 * h * (self.d_next[r] - self.d_now[r]);
+                }
+                Ok((self.estimate(), 1))
+            }
+            Scheme::CrankNicolson if first => {
+                // Rannacher start-up: two backward-Euler half steps, the matrix of CN
+                self.forcing_into_next(t + 0.5 * h);
+                self.rhs_mass(2.0 / h, false);
+                self.solve(2.0 / h, Guess::U)?;
+                std::mem::swap(&mut self.next, &mut self.rhs);
+                self.forcing_into_next(t1);
+                self.rhs_mass(2.0 / h, true);
+                self.cg[0].copy_from_slice(&self.next);
+                self.solve(2.0 / h, Guess::Preset)?;
+                std::mem::swap(&mut self.next, &mut self.rhs);
+                Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
+                for r in 0..n {
+                    self.pred[r] = 0.25 * h * (self.d_next[r] - self.d_now[r]);
+                }
+                Ok((self.estimate(), 1))
+            }
+            Scheme::CrankNicolson => {
+                let w = h / h_prev;
+                for r in 0..n {
+                    self.pred[r] =
+                        self.u[r] + 0.5 * h * ((2.0 + w) * self.d_now[r] - w * self.d_prev[r]);
+                }
+                self.forcing_into_next(t1);
+                // (2M/h + A)θₙ₊₁ = (2M/h − A)θₙ + fₙ + fₙ₊₁ = 2M/h θₙ + M θ'ₙ + fₙ₊₁
+                for r in 0..n {
+                    let m = self.sys.mass[r];
+                    self.rhs[r] = m * (2.0 / h * self.u[r] + self.d_now[r]) + self.f_next[r];
+                }
+                self.cg[0].copy_from_slice(&self.pred);
+                self.solve(2.0 / h, Guess::Preset)?;
+                std::mem::swap(&mut self.next, &mut self.rhs);
+                Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
+                let w = 1.0 / (3.0 * (1.0 + h_prev / h));
+                for r in 0..n {
+                    self.pred[r] = w * (self.next[r] - self.pred[r]);
+                }
+                Ok((self.estimate(), 2))
+            }
+            Scheme::BackwardEuler | Scheme::Bdf2 => {
+                // BDF2 (backward Euler took the first arm); θ(t − h): an accepted value or the Hermite interpolant of the last step
+                let back = t - h;
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * h;
+                if close(back, t_prev) {
+                    self.hist.copy_from_slice(&self.u_prev);
+                } else if accepted >= 2 && close(back, t_prev2) {
+                    self.hist.copy_from_slice(&self.u_prev2);
+                } else if back > t_prev {
+                    Self::hermite(
+                        &self.u_prev,
+                        &self.d_prev,
+                        &self.u,
+                        &self.d_now,
+                        t - t_prev,
+                        (back - t_prev) / (t - t_prev),
+                        &mut self.hist,
+                    );
+                } else {
+                    return Err(Error::Solver {
+                        message: format!(
+                            "BDF2 step {h:e} s at t = {t:e} s reaches behind the stored history (internal)"
+                        ),
+                    });
+                }
+                // predictor: quadratic through the last three accepted values (or, after the
+                // start, through θ₀, θ'₀ and θ₁), extrapolated to t + h; cp its error constant
+                let cp = if accepted >= 2 {
+                    let (t1r, t2r) = ((t_prev - t) / h, (t_prev2 - t) / h);
+                    let l0 = (1.0 - t1r) * (1.0 - t2r) / (t1r * t2r);
+                    let l1 = (1.0 - t2r) / (t1r * (t1r - t2r));
+                    let l2 = (1.0 - t1r) / (t2r * (t2r - t1r));
+                    for r in 0..n {
+                        self.pred[r] = l0 * self.u[r] + l1 * self.u_prev[r] + l2 * self.u_prev2[r];
+                    }
+                    (1.0 - t1r) * (1.0 - t2r) / 6.0
+                } else {
+                    let h0 = t - t_prev;
+                    let x = t1 - t_prev;
+                    for r in 0..n {
+                        let a = (self.u[r] - self.u_prev[r] - self.d_prev[r] * h0) / (h0 * h0);
+                        self.pred[r] = self.u_prev[r] + self.d_prev[r] * x + a * x * x;
+                    }
+                    let t0r = (t_prev - t) / h;
+                    (1.0 - t0r) * (1.0 - t0r) / 6.0
+                };
+                self.forcing_into_next(t1);
+                for r in 0..n {
+                    let m = self.sys.mass[r];
+                    self.rhs[r] = m / h * (2.0 * self.u[r] - 0.5 * self.hist[r]) + self.f_next[r];
+                }
+                self.cg[0].copy_from_slice(&self.pred);
+                self.solve(1.5 / h, Guess::Preset)?;
+                std::mem::swap(&mut self.next, &mut self.rhs);
+                Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
+                let cc = 2.0 / 9.0;
+                let w = cc / (cp + cc);
+                for r in 0..n {
+                    self.pred[r] = w * (self.next[r] - self.pred[r]);
+                }
+                Ok((self.estimate(), 2))
+            }
+        }
+    }
+
+    /// Max norm of the error estimate in `pred` (K).
+    fn estimate(&self) -> f64 {
+        self.pred.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+    }
+
+    /// Integrates from `t0` with steps chosen from a local error estimate (see
+    /// `Implicit::attempt`) and calls `on_output(k, t, θ, K)` at each output time with θ there
+    /// from the cubic Hermite interpolant of the step that covers it (θ and θ' at both ends:
+    /// fourth-order accurate, so the steps need not land on the outputs); `progress(accepted,
+    /// t)` after each accepted step.
+    ///
+    /// **Step control.** Steps are rungs h_k = h_max·2^(−k) of a ladder so that each distinct
+    /// matrix cM + A is factorised once and reused (two factorisations cached). A step is
+    /// accepted when est ≤ tol; the ideal next step is h·0.9·(tol/est)^(1/(p+1)). On
+    /// acceptance the step climbs one rung when that ideal is at least twice the step and 3
+    /// steps were accepted on the rung (two rungs after one step when it is 4× or more; BDF2
+    /// one rung after two steps); on rejection it drops as many rungs as the ideal asks (at
+    /// least one, at most five) and retries from the same state. The first step is the
+    /// largest rung not above `first`. The last step may pass the last output time.
+    pub fn run_adaptive(
+        &mut self,
+        theta: &mut [f64],
+        t0: f64,
+        adaptive: &Adaptive,
+        outputs: &[f64],
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
+        mut progress: impl FnMut(u64, f64),
+    ) -> Result<RunStats> {
+        let tol = adaptive.tolerance;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(Error::model(
+                "time.tolerance",
+                format!("must be a positive number, got {tol}"),
+            ));
+        }
+        let Some(&t_last) = outputs.last() else {
+            return Ok(RunStats::default());
+        };
+        let top = adaptive.max.unwrap_or((t_last - t0) / 10.0);
+        if !(top.is_finite() && top > 0.0) {
+            return Err(Error::model(
+                "time.dt_max",
+                format!("must be a positive number, got {top}"),
+            ));
+        }
+        let n = self.sys.len();
+        self.cg_error = CG_SHARE * tol;
+        for v in [
+            &mut self.u_prev2,
+            &mut self.next,
+            &mut self.d_now,
+            &mut self.d_prev,
+            &mut self.d_next,
+            &mut self.pred,
+            &mut self.hist,
+        ] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        let par = self.options.parallel;
+        self.gather(theta);
+        self.sys.forcing(
+            self.model,
+            t0,
+            &mut self.scratch,
+            &mut self.rate,
+            &mut self.f_now,
+        );
+        Self::derivative(&self.sys, &self.u, &self.f_now, &mut self.d_now, par);
+        let first = match adaptive.first {
+            Some(h) if h.is_finite() && h > 0.0 => h,
+            Some(h) => {
+                return Err(Error::model(
+                    "time.dt",
+                    format!("must be a positive number, got {h}"),
+                ))
+            }
+            None => {
+                let rate = self.d_now.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+                if rate > 0.0 {
+                    tol / rate
+                } else {
+                    (t_last - t0) * 1e-4
+                }
+            }
+        };
+        // the largest rung not above the first step
+        let mut k = ((top / first).log2() - 1e-9).ceil().max(0.0) as u32;
+        let rung = |k: u32| top * 0.5f64.powi(k as i32);
+        let mut stats = RunStats::default();
+        self.stats.tolerance = tol;
+        self.stats.min_step = f64::INFINITY;
+        let (mut t, mut t_prev, mut t_prev2, mut h_prev) = (t0, t0, t0, 0.0);
+        let mut on_rung = 0u32;
+        let mut next_output = 0;
+        while next_output < outputs.len() {
+            if k > MAX_RUNG {
+                return Err(Error::Solver {
+                    message: format!(
+                        "adaptive step fell below {:e} s at t = {t:e} s without meeting time.tolerance = {tol:e} K",
+                        rung(MAX_RUNG)
+                    ),
+                });
+            }
+            let h = rung(k);
+            let (est, p) = self.attempt(stats.steps, t, h, h_prev, t_prev, t_prev2)?;
+            let ideal = if est > 0.0 {
+                SAFETY * (tol / est).powf(1.0 / (p as f64 + 1.0))
+            } else {
+                f64::INFINITY
+            };
+            let accepted = est <= tol;
+            if !accepted {
+                // rejected (or non-finite): drop rungs and retry from the same state
+                self.stats.rejected += 1;
+                on_rung = 0;
+                let cut = if ideal.is_finite() && ideal > 0.0 {
+                    (-ideal.log2()).ceil().clamp(1.0, MAX_CUT as f64) as u32
+                } else {
+                    MAX_CUT
+                };
+                k += cut;
+                continue;
+            }
+            // accept: shift the history
+            std::mem::swap(&mut self.u_prev2, &mut self.u_prev);
+            std::mem::swap(&mut self.u_prev, &mut self.u);
+            std::mem::swap(&mut self.u, &mut self.next);
+            std::mem::swap(&mut self.d_prev, &mut self.d_now);
+            std::mem::swap(&mut self.d_now, &mut self.d_next);
+            std::mem::swap(&mut self.f_now, &mut self.f_next);
+            (t_prev2, t_prev) = (t_prev, t);
+            t += h;
+            h_prev = h;
+            stats.steps += 1;
+            on_rung += 1;
+            if stats.steps == 1 {
+                self.stats.first_step = h;
+            }
+            self.stats.min_step = self.stats.min_step.min(h);
+            self.stats.max_step = self.stats.max_step.max(h);
+            while next_output < outputs.len() && outputs[next_output] <= t + 1e-12 * h {
+                let to = outputs[next_output];
+                let s = ((to - t_prev) / h).clamp(0.0, 1.0);
+                Self::hermite(
+                    &self.u_prev,
+                    &self.d_prev,
+                    &self.u,
+                    &self.d_now,
+                    h,
+                    s,
+                    &mut self.next,
+                );
+                self.scatter_from_next(theta, to)?;
+                on_output(next_output, to, theta, &self.model.conductance)?;
+                next_output += 1;
+            }
+            progress(stats.steps, t);
+            // climb whole rungs: one when the ideal step is twice this one and HYSTERESIS
+            // steps were accepted here, up to GROWTH_RUNGS at once when it is 4× or more
+            // (BDF2 one at a time, needing two steps on the rung: θ(t − 2h) is then stored)
+            let (cap, wait) = match self.scheme {
+                Scheme::Bdf2 => (1, if ideal >= 4.0 { 2 } else { HYSTERESIS }),
+                _ => (GROWTH_RUNGS, if ideal >= 4.0 { 1 } else { HYSTERESIS }),
+            };
+            if ideal >= 2.0 && on_rung >= wait && k > 0 {
+                let up = (ideal.log2().floor() as u32).min(cap).min(k);
+                k -= up;
+                on_rung = 0;
+            }
+        }
+        self.stats.accepted = stats.steps;
+        Ok(stats)
+    }
+
+    /// Writes `next` (the interpolated unknowns) into `theta` and sets the constrained nodes
+    /// at time t.
+    fn scatter_from_next(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        std::mem::swap(&mut self.u, &mut self.next);
+        let done = self.scatter(theta, t);
+        std::mem::swap(&mut self.u, &mut self.next);
+        done
     }
 
     /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
@@ -907,7 +1446,7 @@ impl<'a> Implicit<'a> {
                 &mut self.rate,
                 &mut self.rhs,
             );
-            self.solve(0.0, false)?;
+            self.solve(0.0, Guess::Zero)?;
             std::mem::swap(&mut self.u, &mut self.rhs);
             self.scatter(theta, t)?;
             on_output(k, t, theta, &self.model.conductance)?;
