@@ -60,7 +60,7 @@ pub fn run_model(
     // adaptive runs: dt is the first step (None: chosen from the tolerance)
     let dt = match adaptive {
         Some(_) => case.dt.unwrap_or(0.0),
-        None => choose_dt(&model, case.integrator, case.dt).map_err(in_case)?,
+        None => choose_dt(model, case.integrator, case.dt).map_err(in_case)?,
     };
     let scheme = match case.integrator {
         Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
@@ -70,7 +70,7 @@ pub fn run_model(
     };
     // phase change: the enthalpy form of forward Euler (seed 001), refusing other integrators
     let mut enthalpic = match model.enthalpy {
-        Some(_) => Some(Enthalpic::new(&model, case.integrator).map_err(in_case)?),
+        Some(_) => Some(Enthalpic::new(model, case.integrator).map_err(in_case)?),
         None => None,
     };
     // the implicit system (elimination, symbolic factorisation) is part of the set-up
@@ -84,7 +84,7 @@ pub fn run_model(
                 },
                 ..Options::default()
             };
-            Some(Implicit::new(&model, s, options).map_err(in_case)?)
+            Some(Implicit::new(model, s, options).map_err(in_case)?)
         }
         None => None,
     };
@@ -175,7 +175,7 @@ pub fn run_model(
                 progress(s, total)
             })
         }
-        (None, None) => Explicit::new(&model, case.integrator).run(
+        (None, None) => Explicit::new(model, case.integrator).run(
             &mut theta,
             0.0,
             dt,
@@ -215,9 +215,9 @@ pub fn run_model(
             _ => 0.0,
         },
         dt_stable: if case.integrator.is_implicit() {
-            Integrator::Euler.stable_dt(&model)
+            Integrator::Euler.stable_dt(model)
         } else {
-            case.integrator.stable_dt(&model)
+            case.integrator.stable_dt(model)
         },
         integrator: case.integrator.name().into(),
         output_times: case.outputs.clone(),
