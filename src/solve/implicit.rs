@@ -1074,6 +1074,22 @@ impl<'a> Implicit<'a> {
         }
     }
 
+    /// One backward-Euler solve `(cM + A)θ = cM·v + f(t1)` into `next`, from v = `next` (which
+    /// also starts CG) or else `u`; f(t1) is left in `f_next`.
+    fn be_into_next(&mut self, t1: f64, c: f64, from_next: bool) -> Result<()> {
+        self.forcing_into_next(t1);
+        self.rhs_mass(c, from_next);
+        let guess = if from_next {
+            self.cg[0].copy_from_slice(&self.next);
+            Guess::Preset
+        } else {
+            Guess::U
+        };
+        self.solve(c, guess)?;
+        std::mem::swap(&mut self.next, &mut self.rhs);
+        Ok(())
+    }
+
     /// `rhs = c·M·v + f_next` (W) with v = `next` or `u`.
     fn rhs_mass(&mut self, c: f64, from_next: bool) {
         let v = if from_next { &self.next } else { &self.u };
@@ -1127,10 +1143,7 @@ impl<'a> Implicit<'a> {
             Scheme::BackwardEuler | Scheme::Bdf2
                 if first || self.scheme == Scheme::BackwardEuler =>
             {
-                self.forcing_into_next(t1);
-                self.rhs_mass(1.0 / h, false);
-                self.solve(1.0 / h, Guess::U)?;
-                std::mem::swap(&mut self.next, &mut self.rhs);
+                self.be_into_next(t1, 1.0 / h, false)?;
                 Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
                 for r in 0..n {
                     self.pred[r] = 0.5 * h * (self.d_next[r] - self.d_now[r]);
@@ -1139,15 +1152,8 @@ impl<'a> Implicit<'a> {
             }
             Scheme::CrankNicolson if first => {
                 // Rannacher start-up: two backward-Euler half steps, the matrix of CN
-                self.forcing_into_next(t + 0.5 * h);
-                self.rhs_mass(2.0 / h, false);
-                self.solve(2.0 / h, Guess::U)?;
-                std::mem::swap(&mut self.next, &mut self.rhs);
-                self.forcing_into_next(t1);
-                self.rhs_mass(2.0 / h, true);
-                self.cg[0].copy_from_slice(&self.next);
-                self.solve(2.0 / h, Guess::Preset)?;
-                std::mem::swap(&mut self.next, &mut self.rhs);
+                self.be_into_next(t + 0.5 * h, 2.0 / h, false)?;
+                self.be_into_next(t1, 2.0 / h, true)?;
                 Self::derivative(&self.sys, &self.next, &self.f_next, &mut self.d_next, par);
                 for r in 0..n {
                     self.pred[r] = 0.25 * h * (self.d_next[r] - self.d_now[r]);
