@@ -19,6 +19,7 @@ use crate::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
 use crate::reference::ReferenceTable;
 use crate::solve::explicit::Integrator;
 use crate::symmetry::Symmetry;
+use crate::weights::Order;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -209,12 +210,52 @@ pub struct KernelSpec {
     /// Normalisation: continuum (exact integral, default) or lattice (midpoint sum).
     #[serde(default)]
     pub calibration: Calibration,
-    /// Symmetric correction of K that makes linear fields exact at horizon changes.
+    /// Consistent weights: quadratic (default on meshes), linear, or none (default on boxes).
+    #[serde(default)]
+    pub consistency: Option<Order>,
+    /// Older spelling of `consistency = "linear"`.
     #[serde(default)]
     pub linear_consistency: bool,
     /// Restore the horizon's second moment at nodes whose bonds a pre-crack cuts.
     #[serde(default)]
     pub crack_correction: bool,
+}
+
+/// On a mesh, every boundary set that no `[boundary]` names (and the facets in no group) is
+/// insulated through a mirrored layer: the surface correction of the free-surface skin effect
+/// (formulation §3). `type = "free"` keeps the uncorrected surface; crack groups stay as they are.
+fn unnamed_insulated(
+    faces: &mut [FaceBc],
+    geometry: &MeshGeometry,
+    named: &BTreeMap<String, BoundarySpec>,
+    cracks: &[Crack],
+) {
+    let names = geometry.set_names();
+    let cracked: Vec<usize> = cracks
+        .iter()
+        .filter_map(|c| match c.shape {
+            CrackShape::Set(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    for (s, face) in faces.iter_mut().enumerate() {
+        let given = names.get(s).is_some_and(|n| named.contains_key(n));
+        if !given && !cracked.contains(&s) {
+            *face = FaceBc::LayerInsulated;
+        }
+    }
+}
+
+impl KernelSpec {
+    /// The consistency order asked for, or the default: quadratic on meshes, none on boxes.
+    fn order(&self, mesh: bool) -> Order {
+        match (self.consistency, self.linear_consistency) {
+            (Some(o), _) => o,
+            (None, true) => Order::Linear,
+            (None, false) if mesh => Order::Quadratic,
+            (None, false) => Order::None,
+        }
+    }
 }
 
 fn default_p() -> u8 {
@@ -235,6 +276,7 @@ impl Default for KernelSpec {
             partial_volume: default_pv(),
             bond_rule: BondRule::default(),
             calibration: Calibration::default(),
+            consistency: None,
             linear_consistency: false,
             crack_correction: false,
         }
@@ -937,13 +979,21 @@ impl CaseFile {
                 ),
             ));
         }
-        if self.symmetry.is_symmetric() && self.kernel.linear_consistency {
+        let asked = self.kernel.linear_consistency
+            || self.kernel.consistency.is_some_and(|o| o != Order::None);
+        if self.symmetry.is_symmetric() && asked {
             return Err(err(
-                "kernel.linear_consistency",
+                "kernel.consistency",
                 format!(
-                    "does not apply with symmetry = \"{}\": the correction zeroes every node's first moment Σ K_ij ξ_ij, which the ring/shell pair factors must keep (it carries the (1/r)∂θ/∂r term, seed 001 eqs 10, 21)",
+                    "does not apply with symmetry = \"{}\": the correction zeroes every node's first moment Σ K_ij ξ_ij, which the ring/shell pair factors must keep (it carries the (1/r)∂θ/∂r term, Bobaru & Duangpanya's axisymmetric form, doi:10.1007/s42102-022-00092-3 eqs 10, 21)",
                     self.symmetry.name()
                 ),
+            ));
+        }
+        if self.kernel.linear_consistency && self.kernel.consistency.is_some() {
+            return Err(err(
+                "kernel.linear_consistency",
+                "give either linear_consistency or consistency, not both".to_string(),
             ));
         }
         if self.symmetry.is_symmetric() && (thickness.is_some() || area.is_some()) {
@@ -1058,9 +1108,11 @@ impl CaseFile {
             partial_volume: self.kernel.partial_volume,
             calibration: self.kernel.calibration,
         };
+        let mesh = matches!(geometry, Geometry::Mesh(_));
         let mut faces = match &geometry {
             Geometry::Box(_) => vec![FaceBc::Free; 6],
-            Geometry::Mesh(_) => vec![FaceBc::Free; set_names.len()],
+            // the groups' sets, then the facets that no group names
+            Geometry::Mesh(_) => vec![FaceBc::Free; set_names.len() + 1],
         };
         for (name, b) in &self.boundary {
             let key = |k: &str| format!("boundary.{name}.{k}");
@@ -1109,11 +1161,13 @@ impl CaseFile {
                     Ok(())
                 }
             };
+            let nodal = match method {
+                Some(m) => m == "nodal",
+                None => !mesh,
+            };
             unused(
                 "layers",
-                b.layers.is_some()
-                    && !(b.kind == BoundaryKind::Temperature
-                        && matches!(method, None | Some("nodal"))),
+                b.layers.is_some() && !(b.kind == BoundaryKind::Temperature && nodal),
             )?;
             unused("h", b.h.is_some() && b.kind != BoundaryKind::Convection)?;
             unused(
@@ -1128,6 +1182,11 @@ impl CaseFile {
                 BoundaryKind::Temperature => {
                     let v = value(true)?.expect("required");
                     match method {
+                        // element centroids never lie on a mesh's boundary: hold a mirror
+                        None if mesh => FaceBc::LayerTemperature {
+                            value: v,
+                            layer: Layer::Mirror,
+                        },
                         None | Some("nodal") => {
                             let layers = b.layers.unwrap_or(1.0);
                             if !(layers >= 1.0 && layers.fract() == 0.0) {
@@ -1231,6 +1290,9 @@ impl CaseFile {
             }
         }
         let cracks = self.cracks(path, dim, &set_names, &geometry, &faces)?;
+        if let Geometry::Mesh(g) = &geometry {
+            unnamed_insulated(&mut faces, g, &self.boundary, &cracks);
+        }
         let reference = match self.reference {
             Some(r) => Some(reference(r, path, dim, &outputs)?),
             None => None,
@@ -1292,7 +1354,7 @@ impl CaseFile {
                 cracks,
                 source,
                 initial,
-                linear_consistency: self.kernel.linear_consistency,
+                consistency: self.kernel.order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
                 crack_correction: self.kernel.crack_correction,
                 symmetry: self.symmetry,
             },

@@ -13,7 +13,6 @@ pub mod bc;
 pub mod bench;
 pub mod case;
 pub mod cloud;
-pub mod consistency;
 pub mod crack;
 pub mod error;
 pub mod expr;
@@ -36,5 +35,6 @@ pub mod spatial;
 pub mod stencil;
 pub mod sweep;
 pub mod symmetry;
+pub mod weights;
 
 pub use error::{Error, Result};

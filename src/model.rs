@@ -3,7 +3,6 @@
 use crate::bc::{Boundary, BoundaryInput, FaceBc};
 use crate::cloud::mesh::MeshGeometry;
 use crate::cloud::{BoxGeometry, Cloud, Sides};
-use crate::consistency::{correct, Correction};
 use crate::crack::{
     bond_factors, damage, facet_cutters, growing_path, segments, Cuts, Cutter, Growth,
 };
@@ -15,6 +14,7 @@ use crate::math::Point;
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::symmetry::Symmetry;
+use crate::weights::{correct, Consistency, Order};
 
 /// Initial temperature field.
 #[derive(Debug, Clone)]
@@ -103,8 +103,9 @@ pub struct ModelSpec {
     pub source: Option<Expr>,
     /// Initial temperature.
     pub initial: Initial,
-    /// Correct K so that linear fields are exact at horizon changes ([`crate::consistency`]).
-    pub linear_consistency: bool,
+    /// Which polynomial fields the corrected weights integrate exactly at nodes with a complete
+    /// horizon ([`crate::weights`]).
+    pub consistency: Order,
     /// Restore, at nodes whose bonds a pre-crack cuts, the second moment of their horizon
     /// ([`crate::crack::restore_moment`]).
     pub crack_correction: bool,
@@ -162,6 +163,27 @@ fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
     out
 }
 
+/// Body nodes whose horizon is complete: no boundary without a fictitious layer within reach,
+/// no bond cut (by a crack or the boundary) and one material throughout (material interfaces
+/// keep the bond rule of formulation §2.4, cracks their own correction).
+fn complete_horizons(cloud: &Cloud, horizons: &Horizons, layered: &[bool], mu: &[f64]) -> Vec<bool> {
+    let free = cloud.distances_to_free(layered);
+    if std::env::var("PT_DEBUG").is_ok() {
+        let a = (0..cloud.n_body).filter(|&i| !(free[i] > cloud.horizon[i] + cloud.spacing[i])).count();
+        let b = (0..cloud.n_body).filter(|&i| !horizons.row(i).all(|b| mu.get(b).is_none_or(|&m| m == 1.0))).count();
+        eprintln!("free-limited {a}, cut {b}, layered {layered:?}");
+    }
+    (0..cloud.n_body)
+        .map(|i| {
+            free[i] > cloud.horizon[i] + cloud.spacing[i]
+                && horizons.row(i).all(|b| {
+                    mu.get(b).is_none_or(|&m| m == 1.0)
+                        && cloud.material[horizons.targets[b] as usize] == cloud.material[i]
+                })
+        })
+        .collect()
+}
+
 /// An assembled model.
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -187,8 +209,8 @@ pub struct Model {
     pub boundary: Boundary,
     /// Initial temperature of every node, °C.
     pub theta0: Vec<f64>,
-    /// Result of the linear-consistency correction, when it was asked for.
-    pub correction: Option<Correction>,
+    /// Result of the consistent-weights correction, when it was asked for.
+    pub correction: Option<Consistency>,
     /// Later cuts of pairs by growing cracks, in time order.
     pub growth: Vec<PairCut>,
     /// Cuts of the directed bonds by cracks alone (for damage).
@@ -269,12 +291,6 @@ impl Model {
                 "a flux condition with method = \"relation\" does not apply with phase change; use method = \"mirror\"",
             ));
         }
-        if phase && spec.linear_consistency {
-            return Err(Error::model(
-                "kernel.linear_consistency",
-                "does not apply with phase change: the conductances change with temperature",
-            ));
-        }
         let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
         let band = match spec.kernel.partial_volume {
             PartialVolume::AllOrNothing => 0.0,
@@ -329,29 +345,17 @@ impl Model {
             *w *= m;
         }
         let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
-        let correction = if spec.linear_consistency {
-            // nodes whose bonds reach no boundary without a fictitious layer and cross no crack
-            let free = cloud.distances_to_free(&layered);
-            let sel: Vec<bool> = (0..cloud.n_body)
-                .map(|i| {
-                    free[i] > cloud.horizon[i] + cloud.spacing[i]
-                        && horizons.row(i).all(|b| mu[b] == 1.0)
-                })
-                .collect();
-            let c = correct(&mut conductance, &cloud, &sel, 1e-12, 20_000);
-            if c.min_ratio <= 0.0 {
-                return Err(Error::model(
-                    "kernel.linear_consistency",
-                    format!(
-                        "the correction would make a pair conductance negative (factor {:.3}): the change of horizon is too abrupt; grade it over more regions or set linear_consistency = false",
-                        c.min_ratio
-                    ),
-                ));
-            }
-            Some(c)
-        } else {
-            None
-        };
+        let correction = (spec.consistency != Order::None && !cloud.symmetry.is_symmetric())
+            .then(|| {
+                let sel = complete_horizons(&cloud, &horizons, &layered, mu);
+                correct(
+                    &mut conductance,
+                    &cloud,
+                    &sel,
+                    &bond_conductivity,
+                    spec.consistency,
+                )
+            });
         let needs_micro = spec
             .faces
             .iter()

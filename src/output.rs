@@ -336,10 +336,10 @@ pub struct RunSummary {
     pub reference_seconds: f64,
     /// Rayon threads used.
     pub threads: usize,
-    /// Linear-consistency correction: max relative first moment before and after, CG
-    /// iterations, and the smallest factor applied to a pair conductance.
+    /// Consistent-weights correction: nodes corrected and left out, moment errors before and
+    /// after, iterations, and the range of factors applied to the pair conductances.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub consistency: Option<[f64; 4]>,
+    pub consistency: Option<crate::weights::Consistency>,
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,

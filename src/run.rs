@@ -228,9 +228,7 @@ pub fn run_model(
         wall_seconds: t_run.elapsed().as_secs_f64() - reference_seconds - fem_seconds,
         reference_seconds: reference_seconds + fem_seconds,
         threads: rayon::current_num_threads(),
-        consistency: model
-            .correction
-            .map(|c| [c.before, c.after, c.iterations as f64, c.min_ratio]),
+        consistency: model.correction,
         reference: comparisons,
         implicit: implicit.as_ref().map(|st| st.stats),
     };

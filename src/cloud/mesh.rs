@@ -13,6 +13,9 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::Arc;
 
+/// Name of the boundary set made of the facets that no physical group names (always the last).
+pub const UNNAMED: &str = "(no group)";
+
 /// A region of a mesh geometry: a physical group of the body's dimension.
 #[derive(Debug, Clone)]
 pub struct MeshRegion {
@@ -92,7 +95,12 @@ impl MeshGeometry {
             .collect()
     }
 
-    /// Names of the boundary sets, by set index.
+    /// Index of the set of boundary facets that no group names (after the groups' sets).
+    pub fn unnamed_set(&self) -> usize {
+        self.set_groups().len()
+    }
+
+    /// Names of the boundary sets of the groups, by set index.
     pub fn set_names(&self) -> Vec<String> {
         self.set_groups()
             .iter()
@@ -318,8 +326,22 @@ impl MeshGeometry {
             let c = f.centre();
             (f.cell, [c.x, c.y, c.z].map(f64::to_bits))
         });
+        // the facets that no group names form one more set, after the groups
+        let unnamed = sets.len() as u16;
+        for f in boundary.iter_mut().filter(|f| f.set.is_none()) {
+            f.set = Some(unnamed);
+        }
+        sets.push(FacetSet::new(
+            boundary
+                .iter()
+                .filter(|f| f.set == Some(unnamed))
+                .cloned()
+                .collect(),
+        ));
+        let mut names = self.set_names();
+        names.push(UNNAMED.to_string());
         Ok(MeshSides {
-            names: self.set_names(),
+            names,
             sets,
             boundary: FacetSet::new(boundary),
         })

@@ -1,0 +1,301 @@
+//! The coarse level of the two-level preconditioner for the consistent-weights Newton systems.
+//!
+//! The pair exponent `g_ij = (ℓ_i − ℓ_j)·ξ + ξᵀ(L_i + L_j)ξ` does not change when the
+//! multipliers follow a "null mode": ℓ_i = b + (A + W)(x_i − x_a), L_i = A/2 with b a vector,
+//! A symmetric and W antisymmetric. The Newton matrix is therefore singular in the interior of
+//! the selected nodes and only the boundary of the selection fixes those modes; their smooth
+//! versions have tiny eigenvalues, which stalls plain block-Jacobi CG (thousands of iterations
+//! at 10⁴ nodes). As in smoothed-aggregation multigrid for elasticity with its rigid-body
+//! modes, we cut the selected nodes into aggregates (contiguous runs of the space-filling-curve
+//! order), span each aggregate's null modes, and solve the Galerkin coarse system
+//! `E = Zᵀ H Z` exactly by sparse Cholesky (faer).
+
+use super::{Mom, Problem};
+use crate::math::{Point, Real, Vector};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Conj, Side};
+use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
+
+/// Largest number of null modes per aggregate (3D: 3 + 6 + 3).
+const MAX_MODES: usize = 12;
+/// Coarse vector of one node or aggregate.
+type Modes = SVector<Real, MAX_MODES>;
+/// One block of the coarse matrix.
+type CoarseBlock = SMatrix<Real, MAX_MODES, MAX_MODES>;
+
+/// Selected nodes per aggregate, by dimension.
+fn aggregate_size(dim: usize) -> usize {
+    if let Ok(v) = std::env::var("PT_AGG") {
+        return v.parse().unwrap();
+    }
+    match dim {
+        1 => 8,
+        2 => 48,
+        _ => 96,
+    }
+}
+
+/// The aggregates of the selected nodes and their null modes.
+struct Aggregates {
+    /// Aggregate of each body node (u32::MAX: not selected).
+    agg: Vec<u32>,
+    /// Node ranges of the aggregates, in the selected nodes' order.
+    members: Vec<Vec<u32>>,
+    /// Centre and length scale of each aggregate.
+    centre: Vec<(Point, Real)>,
+    /// Modes per aggregate.
+    m: usize,
+}
+
+/// Aggregates and the factorised coarse matrix.
+pub(super) struct Coarse {
+    aggs: Aggregates,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<Real>,
+    scratch: MemBuffer,
+}
+
+impl Aggregates {
+    /// The k-th null mode of aggregate `a` at node `i`, as scaled multipliers (see [`super::phi`]).
+    fn mode(&self, p: &Problem, a: usize, i: usize, k: usize) -> Mom {
+        let (c, s) = self.centre[a];
+        let dim = p.cloud.dim;
+        let r: Vector = (p.cloud.pos[i] - c) / s;
+        let si = p.cloud.horizon[i] / s;
+        // unscaled ℓ (times s) and L (times s²), then scaled by the node's horizon
+        let mut l = Vector::zeros();
+        let mut big = [[0.0; 3]; 3];
+        if k < dim {
+            l[k] = 1.0;
+        } else if k < dim + dim * (dim + 1) / 2 {
+            let (a1, a2) = sym_pair(dim, k - dim);
+            let mut e = [[0.0; 3]; 3];
+            e[a1][a2] = 1.0;
+            e[a2][a1] = 1.0;
+            for (x, row) in e.iter().enumerate() {
+                for (y, v) in row.iter().enumerate() {
+                    l[x] += v * r[y];
+                    big[x][y] = 0.5 * v;
+                }
+            }
+        } else {
+            let (a1, a2) = anti_pair(k - dim - dim * (dim + 1) / 2);
+            l[a1] += r[a2];
+            l[a2] -= r[a1];
+        }
+        let f = si;
+        let f2 = si * si;
+        Mom::from([
+            l.x * f,
+            l.y * f,
+            l.z * f,
+            big[0][0] * f2,
+            big[1][1] * f2,
+            big[2][2] * f2,
+            2.0 * big[0][1] * f2,
+            2.0 * big[0][2] * f2,
+            2.0 * big[1][2] * f2,
+        ])
+        .component_mul(&p.used)
+    }
+
+    /// u_i = (φ·mode_k(i))_k for the scaled moment vector `ph` of node i.
+    fn project(&self, p: &Problem, i: usize, ph: &Mom) -> Modes {
+        let a = self.agg[i] as usize;
+        let mut u = Modes::zeros();
+        for k in 0..self.m {
+            u[k] = ph.dot(&self.mode(p, a, i, k));
+        }
+        u
+    }
+
+    /// Cuts the selected nodes of `p` into aggregates.
+    fn new(p: &Problem) -> Option<Aggregates> {
+        let dim = p.cloud.dim;
+        let selected: Vec<u32> = (0..p.n() as u32).filter(|&i| p.sel[i as usize]).collect();
+        if selected.is_empty() {
+            return None;
+        }
+        let members: Vec<Vec<u32>> = selected
+            .chunks(aggregate_size(dim))
+            .map(<[u32]>::to_vec)
+            .collect();
+        let mut agg = vec![u32::MAX; p.n()];
+        let centre = members
+            .iter()
+            .enumerate()
+            .map(|(a, list)| {
+                let mut c = Vector::zeros();
+                let mut s = 0.0;
+                for &i in list {
+                    agg[i as usize] = a as u32;
+                    c += p.cloud.pos[i as usize].coords;
+                    s += p.cloud.horizon[i as usize];
+                }
+                let n = list.len() as Real;
+                (Point::from(c / n), s / n)
+            })
+            .collect();
+        Some(Aggregates {
+            agg,
+            members,
+            centre,
+            m: dim + dim * dim,
+        })
+    }
+
+    /// The lower triangle of E = Σ_pairs K' (u_i + u_j)(u_i + u_j)ᵀ for the weights `vals`.
+    fn matrix(&self, p: &Problem, vals: &[Real]) -> Option<SparseColMat<usize, Real>> {
+        let m = self.m;
+        let rows: Vec<Vec<(usize, CoarseBlock)>> = (0..self.members.len())
+            .into_par_iter()
+            .map(|a| self.aggregate_rows(p, vals, a))
+            .collect();
+        let mut trip = Vec::new();
+        for (a, blocks) in rows.iter().enumerate() {
+            for (b, blk) in blocks.iter().filter(|(b, _)| *b <= a) {
+                for r in 0..m {
+                    for c in 0..m {
+                        if *b == a && c > r {
+                            continue;
+                        }
+                        let mut v = blk[(r, c)];
+                        if *b == a && r == c {
+                            // modes that vanish on a tiny aggregate: keep E definite
+                            v = if v > 0.0 { v * (1.0 + 1e-10) } else { 1.0 };
+                        }
+                        trip.push(Triplet::new(a * m + r, *b * m + c, v));
+                    }
+                }
+            }
+        }
+        let nc = self.members.len() * m;
+        SparseColMat::<usize, Real>::try_new_from_triplets(nc, nc, &trip).ok()
+    }
+
+    /// The blocks E[a, b] from the rows of aggregate a's nodes.
+    fn aggregate_rows(&self, p: &Problem, vals: &[Real], a: usize) -> Vec<(usize, CoarseBlock)> {
+        let mut out: Vec<(usize, CoarseBlock)> = vec![(a, CoarseBlock::zeros())];
+        for &i in &self.members[a] {
+            let i = i as usize;
+            for e in p.offsets[i]..p.offsets[i + 1] {
+                let j = p.cols[e] as usize;
+                let (pi, pj) = p.phis(i, j);
+                let ui = self.project(p, i, &pi) * vals[e];
+                out[0].1 += ui * self.project(p, i, &pi).transpose();
+                if j < p.n() && p.sel[j] {
+                    let b = self.agg[j] as usize;
+                    let uj = self.project(p, j, &pj);
+                    let slot = match out.iter().position(|(x, _)| *x == b) {
+                        Some(s) => s,
+                        None => {
+                            out.push((b, CoarseBlock::zeros()));
+                            out.len() - 1
+                        }
+                    };
+                    out[slot].1 += ui * uj.transpose();
+                }
+            }
+        }
+        out
+    }
+
+    /// Zᵀ r, aggregate by aggregate.
+    fn restrict(&self, p: &Problem, r: &[Mom]) -> Vec<Real> {
+        let m = self.m;
+        self.members
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(a, list)| {
+                let mut s = Modes::zeros();
+                for &i in list {
+                    for k in 0..m {
+                        s[k] += self.mode(p, a, i as usize, k).dot(&r[i as usize]);
+                    }
+                }
+                (0..m).map(move |k| s[k])
+            })
+            .collect()
+    }
+
+    /// z += Z c.
+    fn prolong(&self, p: &Problem, c: &[Real], z: &mut [Mom]) {
+        let m = self.m;
+        z.par_iter_mut().enumerate().for_each(|(i, zi)| {
+            let a = self.agg[i];
+            if a == u32::MAX {
+                return;
+            }
+            let a = a as usize;
+            for k in 0..m {
+                *zi += c[a * m + k] * self.mode(p, a, i, k);
+            }
+        });
+    }
+}
+
+impl Coarse {
+    /// Builds the aggregates and factorises E for the weights `vals`; None if it fails.
+    pub(super) fn new(p: &Problem, vals: &[Real]) -> Option<Coarse> {
+        let aggs = Aggregates::new(p)?;
+        let e = aggs.matrix(p, vals)?;
+        let par = faer::get_global_parallelism();
+        let symbolic = factorize_symbolic_cholesky(
+            e.symbolic(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .ok()?;
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut work =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<Real>(par, Default::default()));
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                e.as_ref(),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut work),
+                Default::default(),
+            )
+            .ok()?;
+        let scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<Real>(1, par));
+        Some(Coarse {
+            aggs,
+            symbolic,
+            values,
+            scratch,
+        })
+    }
+
+    /// z += Z E⁻¹ Zᵀ r.
+    pub(super) fn apply(&mut self, p: &Problem, r: &[Mom], z: &mut [Mom]) {
+        let mut c = self.aggs.restrict(p, r);
+        let n = c.len();
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(&mut c, n, 1),
+            faer::get_global_parallelism(),
+            MemStack::new(&mut self.scratch),
+        );
+        self.aggs.prolong(p, &c, z);
+    }
+}
+
+/// Axes of the q-th symmetric basis matrix: the diagonal ones first, then xy, xz, yz.
+fn sym_pair(dim: usize, q: usize) -> (usize, usize) {
+    if q < dim {
+        return (q, q);
+    }
+    [(0, 1), (0, 2), (1, 2)][q - dim]
+}
+
+/// Axes of the q-th antisymmetric basis matrix: xy, xz, yz.
+fn anti_pair(q: usize) -> (usize, usize) {
+    [(0, 1), (0, 2), (1, 2)][q]
+}
