@@ -983,7 +983,11 @@ impl CaseFile {
             || self.kernel.consistency.is_some_and(|o| o != Order::None);
         if self.symmetry.is_symmetric() && asked {
             return Err(err(
-                "kernel.consistency",
+                if self.kernel.linear_consistency {
+                    "kernel.linear_consistency"
+                } else {
+                    "kernel.consistency"
+                },
                 format!(
                     "does not apply with symmetry = \"{}\": the correction zeroes every node's first moment Σ K_ij ξ_ij, which the ring/shell pair factors must keep (it carries the (1/r)∂θ/∂r term, Bobaru & Duangpanya's axisymmetric form, doi:10.1007/s42102-022-00092-3 eqs 10, 21)",
                     self.symmetry.name()

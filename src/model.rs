@@ -211,6 +211,8 @@ pub struct Model {
     pub theta0: Vec<f64>,
     /// Result of the consistent-weights correction, when it was asked for.
     pub correction: Option<Consistency>,
+    /// Body nodes whose moments the correction met (all false without it).
+    pub consistent: Vec<bool>,
     /// Later cuts of pairs by growing cracks, in time order.
     pub growth: Vec<PairCut>,
     /// Cuts of the directed bonds by cracks alone (for damage).
@@ -345,17 +347,20 @@ impl Model {
             *w *= m;
         }
         let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
-        let correction = (spec.consistency != Order::None && !cloud.symmetry.is_symmetric())
-            .then(|| {
+        let (correction, consistent) =
+            if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
                 let sel = complete_horizons(&cloud, &horizons, &layered, mu);
-                correct(
+                let (c, met) = correct(
                     &mut conductance,
                     &cloud,
                     &sel,
                     &bond_conductivity,
                     spec.consistency,
-                )
-            });
+                );
+                (Some(c), met)
+            } else {
+                (None, vec![false; cloud.n_body])
+            };
         let needs_micro = spec
             .faces
             .iter()
@@ -413,6 +418,7 @@ impl Model {
             boundary,
             theta0,
             correction,
+            consistent,
             growth,
             crack_cuts,
         })

@@ -354,14 +354,17 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
     let mut d0 = p.dual(lambda, vals);
     for _ in 0..MAX_NEWTON {
         let res = p.residual(vals);
-        if p.worst(&res) <= TOLERANCE {
+        let worst = p.worst(&res);
+        if worst <= TOLERANCE {
             break;
         }
         let rhs: Vec<Mom> = res.iter().map(|r| -r).collect();
+        // inexact Newton: the linear solve only as accurate as the step can use
+        let forcing = (0.1 * worst).clamp(1e-6, 1e-2);
         // a factor of H at earlier weights preconditions CG until CG needs many iterations
         let mut it = usize::MAX;
         if let Some(d) = direct.as_mut().filter(|_| newton > 0) {
-            it = solve(p, vals, &rhs, &mut step, &mut Precond::Direct(d), 1e-4);
+            it = solve(p, vals, &rhs, &mut step, &mut Precond::Direct(d), forcing);
         }
         if std::env::var("PT_DEBUG").is_ok() && it != usize::MAX {
             eprintln!("pcg with old factor: {it}");
@@ -375,7 +378,7 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
                 direct = None;
                 let mut pre =
                     Precond::TwoLevel(p.preconditioner(vals), coarse::Coarse::new(p, vals));
-                it = solve(p, vals, &rhs, &mut step, &mut pre, 1e-4);
+                it = solve(p, vals, &rhs, &mut step, &mut pre, forcing);
             }
         }
         let solved = direct.is_some();
@@ -413,13 +416,14 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
 
 /// Corrects `k` in place so that the body nodes with `sel[i]` meet the moments of `order`
 /// (see the module documentation); `conductivity[i]` is the k_i of node i's target, W/(m·K).
+/// Returns what was achieved and which body nodes now meet their moments.
 pub fn correct(
     k: &mut Conductance,
     cloud: &Cloud,
     sel: &[bool],
     conductivity: &[Real],
     order: Order,
-) -> Consistency {
+) -> (Consistency, Vec<bool>) {
     let n = k.n_rows();
     let dim = cloud.dim;
     let quad = order == Order::Quadratic;
@@ -516,7 +520,7 @@ pub fn correct(
     for i in 0..n {
         k.diag[i] = k.vals[k.offsets[i]..k.offsets[i + 1]].iter().sum();
     }
-    out
+    (out, p.sel)
 }
 
 /// Fills the counts, errors and ratios of `out` from the final weights.
