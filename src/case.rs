@@ -1358,7 +1358,9 @@ impl CaseFile {
                 cracks,
                 source,
                 initial,
-                consistency: self.kernel.order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
+                consistency: self
+                    .kernel
+                    .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
                 crack_correction: self.kernel.crack_correction,
                 symmetry: self.symmetry,
             },

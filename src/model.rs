@@ -166,13 +166,13 @@ fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
 /// Body nodes whose horizon is complete: no boundary without a fictitious layer within reach,
 /// no bond cut (by a crack or the boundary) and one material throughout (material interfaces
 /// keep the bond rule of formulation §2.4, cracks their own correction).
-fn complete_horizons(cloud: &Cloud, horizons: &Horizons, layered: &[bool], mu: &[f64]) -> Vec<bool> {
+fn complete_horizons(
+    cloud: &Cloud,
+    horizons: &Horizons,
+    layered: &[bool],
+    mu: &[f64],
+) -> Vec<bool> {
     let free = cloud.distances_to_free(layered);
-    if std::env::var("PT_DEBUG").is_ok() {
-        let a = (0..cloud.n_body).filter(|&i| !(free[i] > cloud.horizon[i] + cloud.spacing[i])).count();
-        let b = (0..cloud.n_body).filter(|&i| !horizons.row(i).all(|b| mu.get(b).is_none_or(|&m| m == 1.0))).count();
-        eprintln!("free-limited {a}, cut {b}, layered {layered:?}");
-    }
     (0..cloud.n_body)
         .map(|i| {
             free[i] > cloud.horizon[i] + cloud.spacing[i]

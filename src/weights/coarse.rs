@@ -28,9 +28,6 @@ type CoarseBlock = SMatrix<Real, MAX_MODES, MAX_MODES>;
 
 /// Selected nodes per aggregate, by dimension.
 fn aggregate_size(dim: usize) -> usize {
-    if let Ok(v) = std::env::var("PT_AGG") {
-        return v.parse().unwrap();
-    }
     match dim {
         1 => 8,
         2 => 48,

@@ -13,8 +13,10 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Side};
 use rayon::prelude::*;
 
-/// Largest number of unknowns solved directly (beyond it: CG with the two-level preconditioner).
-pub(super) const MAX_UNKNOWNS: usize = 400_000;
+/// Largest number of stored entries of H's lower triangle solved directly (beyond it, or in
+/// 3D where the fill of a horizon of ~100 neighbours grows too fast: CG with the two-level
+/// preconditioner). 4·10⁶ entries are ~37 000 unknowns of a 2D cloud at δ = 3Δ.
+const MAX_ENTRIES: usize = 4_000_000;
 
 /// The lower triangle of H in compressed columns, and its Cholesky factor.
 pub(super) struct Direct {
@@ -38,7 +40,12 @@ impl Direct {
         let nu = comps.len();
         let nodes: Vec<u32> = (0..p.n() as u32).filter(|&i| p.sel[i as usize]).collect();
         let unknowns = nodes.len() * nu;
-        if unknowns == 0 || unknowns > MAX_UNKNOWNS || std::env::var("PT_NODIRECT").is_ok() {
+        let later: usize = nodes
+            .iter()
+            .map(|&i| Self::later_count(p, i as usize))
+            .sum();
+        let entries = later * nu * nu + nodes.len() * nu * (nu + 1) / 2;
+        if unknowns == 0 || entries > MAX_ENTRIES || p.cloud.dim == 3 {
             return None;
         }
         let mut pos = vec![u32::MAX; p.n()];
@@ -57,9 +64,8 @@ impl Direct {
                 col_ptr.push(row_idx.len());
             }
         }
-        let structure = SymbolicSparseColMatRef::new_checked(
-            unknowns, unknowns, &col_ptr, None, &row_idx,
-        );
+        let structure =
+            SymbolicSparseColMatRef::new_checked(unknowns, unknowns, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(
             structure,
             Side::Lower,
@@ -83,6 +89,12 @@ impl Direct {
             symbolic,
             scratch,
         })
+    }
+
+    /// Number of neighbours j > i of node i in the CSR row (an upper bound on the selected ones).
+    fn later_count(p: &Problem, i: usize) -> usize {
+        let row = &p.cols[p.offsets[i]..p.offsets[i + 1]];
+        row.len() - row.partition_point(|&j| j as usize <= i)
     }
 
     /// Selected neighbours j > i of node i, in increasing order (the CSR rows are sorted).

@@ -185,7 +185,11 @@ impl Problem<'_> {
                 let mut s = 0.0;
                 for e in self.offsets[i]..self.offsets[i + 1] {
                     // pairs of two body nodes appear in both rows
-                    let half = if (self.cols[e] as usize) < n { 0.5 } else { 1.0 };
+                    let half = if (self.cols[e] as usize) < n {
+                        0.5
+                    } else {
+                        1.0
+                    };
                     s += half * vals[e];
                 }
                 s - self.lam(lambda, i).map_or(0.0, |l| l.dot(&self.target[i]))
@@ -262,13 +266,17 @@ impl Problem<'_> {
                 }
                 match b.cholesky() {
                     Some(ch) => ch.inverse(),
-                    None => Block::from_diagonal(&b.diagonal().map(|d| {
-                        if d > 0.0 {
-                            1.0 / d
-                        } else {
-                            1.0
-                        }
-                    })),
+                    None => {
+                        Block::from_diagonal(&b.diagonal().map(
+                            |d| {
+                                if d > 0.0 {
+                                    1.0 / d
+                                } else {
+                                    1.0
+                                }
+                            },
+                        ))
+                    }
                 }
             })
             .collect()
@@ -307,7 +315,14 @@ impl Precond<'_> {
 }
 
 /// Solves H x = b by preconditioned CG to `rel` of |b|; returns the iterations.
-fn solve(p: &Problem, vals: &[Real], b: &[Mom], x: &mut [Mom], pre: &mut Precond, rel: Real) -> usize {
+fn solve(
+    p: &Problem,
+    vals: &[Real],
+    b: &[Mom],
+    x: &mut [Mom],
+    pre: &mut Precond,
+    rel: Real,
+) -> usize {
     let cap = 20_000;
     let precondition = |r: &[Mom], z: &mut Vec<Mom>, pre: &mut Precond| pre.apply(p, r, z);
     x.iter_mut().for_each(|v| *v = Mom::zeros());
@@ -335,7 +350,9 @@ fn solve(p: &Problem, vals: &[Real], b: &[Mom], x: &mut [Mom], pre: &mut Precond
         let rz_new = dot(&r, &z);
         let beta = rz_new / rz;
         rz = rz_new;
-        d.par_iter_mut().zip(&z).for_each(|(d, z)| *d = z + beta * *d);
+        d.par_iter_mut()
+            .zip(&z)
+            .for_each(|(d, z)| *d = z + beta * *d);
         it += 1;
     }
     it
@@ -348,7 +365,6 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
     let mut step = vec![Mom::zeros(); n];
     let mut trial = vec![Mom::zeros(); n];
     let mut trial_vals = vec![0.0; vals.len()];
-    let t0 = std::time::Instant::now();
     let mut direct = direct::Direct::new(p);
     p.weights(lambda, vals);
     let mut d0 = p.dual(lambda, vals);
@@ -366,9 +382,6 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
         if let Some(d) = direct.as_mut().filter(|_| newton > 0) {
             it = solve(p, vals, &rhs, &mut step, &mut Precond::Direct(d), forcing);
         }
-        if std::env::var("PT_DEBUG").is_ok() && it != usize::MAX {
-            eprintln!("pcg with old factor: {it}");
-        }
         if it > 25 {
             it = 0;
             let factored = direct.as_mut().is_some_and(|d| d.factorise(p, vals));
@@ -380,11 +393,6 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
                     Precond::TwoLevel(p.preconditioner(vals), coarse::Coarse::new(p, vals));
                 it = solve(p, vals, &rhs, &mut step, &mut pre, forcing);
             }
-        }
-        let solved = direct.is_some();
-        if std::env::var("PT_DEBUG").is_ok() {
-            eprintln!("t {:.3}", t0.elapsed().as_secs_f64());
-            eprintln!("newton: worst {:.3e} cg {it} direct {solved}", p.worst(&res));
         }
         cg += it;
         newton += 1;
@@ -506,7 +514,11 @@ pub fn correct(
         }
         // nodes that admit no positive symmetric solution drive their λ to infinity: leave
         // out the ones still far from their moments and start again from λ = 0
-        let cut = bad.iter().map(|&i| res[i].amax() / p.unit[i]).fold(0.0, Real::max) * 1e-3;
+        let cut = bad
+            .iter()
+            .map(|&i| res[i].amax() / p.unit[i])
+            .fold(0.0, Real::max)
+            * 1e-3;
         for &i in &bad {
             if res[i].amax() / p.unit[i] >= cut.max(TOLERANCE) {
                 p.sel[i] = false;

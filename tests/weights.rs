@@ -1,0 +1,179 @@
+//! Consistent bond weights (src/weights) on gmsh meshes of every element kind: quadratic
+//! fields integrated exactly, K symmetric and positive, energy conserved, the explicit bound
+//! still stable. The meshes are meshes/moments_*.msh (triangles, unstructured quadrangles,
+//! mixed, graded 4×, tetrahedra; the hexahedra of moments_hex.msh are the open case below).
+
+use peritherm::case::Case;
+use peritherm::model::Model;
+use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::weights::Order;
+use std::path::Path;
+
+const MESHES: [(&str, usize); 5] = [
+    ("moments_tri.msh", 2),
+    ("moments_quad.msh", 2),
+    ("moments_mixed.msh", 2),
+    ("moments_graded.msh", 2),
+    ("moments_tet.msh", 3),
+];
+
+/// A case on `file` with conductivity 2, the wall given `wall` (a TOML table body).
+fn model(file: &str, dim: usize, wall: &str, initial: &str, order: Option<&str>) -> Model {
+    let consistency = order.map_or(String::new(), |o| format!("consistency = \"{o}\"\n"));
+    let text = format!(
+        r#"
+dimension = {dim}
+[mesh]
+file = "../meshes/{file}"
+[[region]]
+name = "body"
+horizon = {{ factor = 3 }}
+[material.m]
+conductivity = 2.0
+density = 1.0
+specific_heat = 1.0
+[kernel]
+{consistency}
+[boundary.wall]
+{wall}
+[initial]
+value = "{initial}"
+[time]
+end = 1.0
+integrator = "euler"
+"#
+    );
+    let case = Case::parse(&text, Path::new("tests/weights.toml")).unwrap();
+    Model::build(&case.spec).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+/// θ = 1 + 2x − 3y + z + 3x² − 2xy + 1.5y² + 0.5z² + yz, and its Laplacian (9 in 3D, 9 in 2D:
+/// the z terms vanish on z = 0 but 0.5z² still adds 1 in 3D).
+fn quadratic(p: &peritherm::math::Point, dim: usize) -> (f64, f64) {
+    let (x, y, z) = (p.x, p.y, p.z);
+    let t =
+        1.0 + 2.0 * x - 3.0 * y + z + 3.0 * x * x - 2.0 * x * y + 1.5 * y * y + 0.5 * z * z + y * z;
+    (t, if dim == 3 { 10.0 } else { 9.0 })
+}
+
+/// Largest |Σ_j K_ij (θ_j − θ_i) − V_i k ∇²θ| / (V_i k (|∇²θ| + |∇θ|/δ_i)) over the nodes the
+/// correction met, θ quadratic and evaluated at every node (fictitious ones included).
+fn quadratic_error(m: &Model, dim: usize) -> (f64, usize) {
+    let theta: Vec<f64> = m.cloud.pos.iter().map(|p| quadratic(p, dim).0).collect();
+    let mut flow = vec![0.0; m.cloud.n_body];
+    m.conductance.apply(&theta, &mut flow);
+    let mut worst = 0.0f64;
+    let mut count = 0;
+    for i in 0..m.cloud.n_body {
+        let selected = m.consistent[i] || m.correction.is_none();
+        if !selected {
+            continue;
+        }
+        count += 1;
+        let (_, lap) = quadratic(&m.cloud.pos[i], dim);
+        let vk = m.cloud.volume[i] * 2.0;
+        let scale = vk * (lap + 10.0 / m.cloud.horizon[i]);
+        worst = worst.max((flow[i] - vk * lap).abs() / scale);
+    }
+    (worst, count)
+}
+
+/// With mirrored insulated walls every node has a complete horizon: the corrected operator is
+/// V_i k ∇²θ for a quadratic θ at every node of every mesh kind (tolerance 1e-8 of the scale:
+/// the moments are met to 1e-10 relative), where the kernel's own weights miss by > 1e-3.
+#[test]
+fn quadratic_fields_are_integrated_exactly_on_every_mesh_kind() {
+    for (file, dim) in MESHES {
+        let wall = "type = \"insulated\"";
+        let m = model(file, dim, wall, "0", None);
+        let c = m.correction.expect("meshes are corrected by default");
+        assert_eq!(c.uncorrected, 0, "{file}: {c:?}");
+        assert_eq!(c.corrected, m.cloud.n_body, "{file}: {c:?}");
+        assert!(c.min_ratio > 0.0, "{file}: {c:?}");
+        let (after, n) = quadratic_error(&m, dim);
+        assert_eq!(n, m.cloud.n_body);
+        assert!(after < 1e-8, "{file}: {after:e}");
+        let plain = model(file, dim, wall, "0", Some("none"));
+        let (before, _) = quadratic_error(&plain, dim);
+        assert!(
+            before > 1e-3,
+            "{file}: the kernel alone already exact? {before:e}"
+        );
+    }
+}
+
+/// With free walls (no fictitious nodes) the corrected K is symmetric bit for bit with every
+/// entry positive, an Euler run at 0.99 of the stable bound stays bounded by the initial
+/// maximum for 10⁴ steps (positive weights: each step is a convex combination), and the
+/// energy is conserved to 1e-12 relative.
+#[test]
+fn consistent_weights_are_symmetric_positive_stable_and_conservative() {
+    for (file, dim) in MESHES {
+        let m = model(
+            file,
+            dim,
+            "type = \"free\"",
+            "2 + sin(40*x)*cos(37*y) + z",
+            None,
+        );
+        let c = m.correction.unwrap();
+        assert!(c.corrected > 0, "{file}: {c:?}");
+        let k = &m.conductance;
+        for i in 0..k.n_rows() {
+            for b in k.offsets[i]..k.offsets[i + 1] {
+                let j = k.cols[b] as usize;
+                assert!(k.vals[b] > 0.0, "{file}");
+                assert_eq!(k.vals[b].to_bits(), k.get(j, i).to_bits(), "{file}");
+            }
+        }
+        let dt = 0.99 * choose_dt(&m, Integrator::Euler, None).unwrap();
+        let mut theta = m.theta0.clone();
+        let top = theta.iter().cloned().fold(f64::MIN, f64::max);
+        let bottom = theta.iter().cloned().fold(f64::MAX, f64::min);
+        let e0 = m.energy(&theta);
+        let mut st = Explicit::new(&m, Integrator::Euler);
+        for s in 0..10_000 {
+            st.step(&mut theta, s as f64 * dt, dt);
+        }
+        let hi = theta.iter().cloned().fold(f64::MIN, f64::max);
+        let lo = theta.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(
+            hi <= top + 1e-9 && lo >= bottom - 1e-9,
+            "{file}: {lo}..{hi}"
+        );
+        let e = m.energy(&theta);
+        assert!(((e - e0) / e0).abs() <= 1e-12, "{file}: {e} vs {e0}");
+    }
+}
+
+/// The linear order zeroes first moments only: a linear field is steady, a quadratic one is
+/// not integrated exactly (the second moments keep the quadrature bias).
+#[test]
+fn the_linear_order_leaves_second_moments_alone() {
+    let m = model(
+        "moments_tri.msh",
+        2,
+        "type = \"insulated\"",
+        "0",
+        Some("linear"),
+    );
+    assert!(m.correction.unwrap().after < 1e-10);
+    let (err, _) = quadratic_error(&m, 2);
+    assert!(err > 1e-4, "{err:e}");
+    assert_eq!(Order::default(), Order::Quadratic);
+}
+
+/// Extruded hexahedra (moments_hex.msh, 6 layers): OPEN. The correction meets the moments at
+/// 414 of 594 nodes and leaves 180 with no positive symmetric solution found; the mesh is not
+/// refused, and the nodes left out are counted with how far from exact they stay. This test
+/// pins that report (it fails, and should be tightened, once the hexahedra are corrected).
+#[test]
+fn hexahedra_left_out_nodes_are_reported_not_refused() {
+    let m = model("moments_hex.msh", 3, "type = \"insulated\"", "0", None);
+    let c = m.correction.unwrap();
+    assert!(c.uncorrected > 0 && c.worst_uncorrected > 0.0, "{c:?}");
+    assert_eq!(c.corrected + c.uncorrected, m.cloud.n_body, "{c:?}");
+    assert!(c.after < 1e-10 && c.min_ratio > 0.0, "{c:?}");
+    let met = m.consistent.iter().filter(|&&x| x).count();
+    assert_eq!(met, c.corrected);
+}
