@@ -237,6 +237,9 @@ pub struct Row {
     pub delta_min: f64,
     /// δ/Δ at the node with the smallest horizon.
     pub ratio: f64,
+    /// Mean node spacing h = (Σ V_i / (τ N))^(1/d) over the N body nodes, m (τ the 2D
+    /// thickness or 1D area; axisymmetric volumes carry their 2πr).
+    pub h_mean: f64,
     /// Output time, s.
     pub time: f64,
     /// max |θ − θ_ref| over the body nodes compared, °C.
@@ -248,6 +251,9 @@ pub struct Row {
     /// Seed 001 eq 27: rms difference / max |θ_ref| (the other run's field is the reference
     /// when comparing with a run).
     pub epsilon: Option<f64>,
+    /// Volume-weighted relative L2 error over all body nodes, ‖θ − θ_ref‖/‖θ_ref‖
+    /// (classical references only), dimensionless.
+    pub l2_rel: Option<f64>,
     /// What it is compared with.
     pub against: String,
 }
@@ -264,7 +270,7 @@ pub fn csv(rows: &[Row]) -> String {
         s.push_str(k);
         s.push(',');
     }
-    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,time,max_abs,mean_abs,eq13,epsilon,against\n");
+    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,h_mean,time,max_abs,mean_abs,eq13,epsilon,l2_rel,against\n");
     for r in rows {
         s.push_str(&r.label);
         s.push(',');
@@ -273,18 +279,20 @@ pub fn csv(rows: &[Row]) -> String {
             s.push(',');
         }
         s.push_str(&format!(
-            "{},{},{},{:.3},{:e},{},{},{:e},{},{},{},{}\n",
+            "{},{},{},{:.3},{:e},{},{:e},{},{:e},{},{},{},{},{}\n",
             r.nodes,
             r.bonds,
             r.steps,
             r.wall_seconds,
             r.delta_min,
             r.ratio,
+            r.h_mean,
             r.time,
             r.max_abs,
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
+            opt(r.l2_rel),
             r.against
         ));
     }
@@ -301,11 +309,11 @@ pub fn markdown(rows: &[Row]) -> String {
     for k in &keys {
         s.push_str(&format!(" {k} |"));
     }
-    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | against |\n|---|");
+    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | h (m) | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | rel. L2 | against |\n|---|");
     for _ in &keys {
         s.push_str("---|");
     }
-    s.push_str("---|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str("---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     let opt = |v: Option<f64>| v.map(|x| format!("{x:.3e}")).unwrap_or_else(|| "-".into());
     for r in rows {
         s.push_str(&format!("| {} |", r.label));
@@ -313,17 +321,19 @@ pub fn markdown(rows: &[Row]) -> String {
             s.push_str(&format!(" {v} |"));
         }
         s.push_str(&format!(
-            " {} | {} | {:.3e} | {:.3} | {:.1} | {} | {:.3e} | {} | {} | {} | {} |\n",
+            " {} | {} | {:.3e} | {:.3} | {:.3e} | {:.1} | {} | {:.3e} | {} | {} | {} | {} | {} |\n",
             r.nodes,
             r.bonds,
             r.delta_min,
             r.ratio,
+            r.h_mean,
             r.wall_seconds,
             r.time,
             r.max_abs,
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
+            opt(r.l2_rel),
             r.against
         ));
     }
@@ -370,6 +380,8 @@ pub fn run(
             run_case(&v.case, &dir, |_, _| {})?
         };
         let cloud = v.case.spec.geometry.bare_cloud()?;
+        let measure: f64 = cloud.volume[..cloud.n_body].iter().sum::<f64>() / cloud.tau;
+        let h_mean = (measure / cloud.n_body.max(1) as f64).powf(1.0 / cloud.dim as f64);
         let finest = (0..cloud.n_body)
             .min_by(|&a, &b| cloud.horizon[a].total_cmp(&cloud.horizon[b]))
             .unwrap_or(0);
@@ -382,11 +394,13 @@ pub fn run(
             wall_seconds: summary.setup_seconds + summary.wall_seconds,
             delta_min: cloud.horizon[finest],
             ratio: cloud.horizon[finest] / cloud.spacing[finest],
+            h_mean,
             time: 0.0,
             max_abs: 0.0,
             mean_abs: None,
             eq13: None,
             epsilon: None,
+            l2_rel: None,
             against: String::new(),
         };
         let reference_dir = match against {
@@ -406,6 +420,7 @@ pub fn run(
                         max_abs: c.max_abs_diff,
                         eq13: Some(c.l2_rel_line),
                         epsilon: Some(c.epsilon),
+                        l2_rel: Some(c.l2_rel_volume),
                         against: "reference".into(),
                         ..base.clone()
                     });
@@ -491,6 +506,20 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
     if !(0..keys.len()).any(proportional) {
         axes.push(("δ_min (m)".into(), Box::new(|r: &Row| Some(r.delta_min))));
     }
+    // the mean spacing, unless a varied key is proportional to it (a spacing sweep)
+    let follows_h = |i: usize| {
+        let ratios: Vec<f64> = rows
+            .iter()
+            .filter_map(|r| Some(r.settings[i].1.parse::<f64>().ok()? / r.h_mean))
+            .collect();
+        ratios.len() == rows.len() && ratios.iter().all(|q| (q / ratios[0] - 1.0).abs() < 1e-6)
+    };
+    if !(0..keys.len()).any(follows_h) {
+        axes.push((
+            "h = (V/N)^(1/d) (m)".into(),
+            Box::new(|r: &Row| Some(r.h_mean)),
+        ));
+    }
     let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
     times.sort_by(f64::total_cmp);
     times.dedup();
@@ -523,6 +552,18 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
                     .colour(1),
                 );
             }
+            if at.iter().all(|r| r.l2_rel.is_some_and(|e| e > 0.0)) {
+                series.push(
+                    Series::new(
+                        "relative L2",
+                        xs.iter()
+                            .zip(&at)
+                            .map(|(x, r)| (*x, r.l2_rel.unwrap_or(0.0)))
+                            .collect(),
+                    )
+                    .colour(2),
+                );
+            }
             series.retain(|s| s.points.iter().all(|p| p.1 > 0.0));
             if series.is_empty() {
                 continue;
@@ -530,6 +571,8 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
             let short = name.rsplit('.').next().unwrap_or(name);
             let slug: String = if short.starts_with('δ') {
                 "delta".into()
+            } else if short.starts_with("h = ") {
+                "h".into()
             } else {
                 short
                     .chars()
