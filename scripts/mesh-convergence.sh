@@ -8,6 +8,7 @@
 # (least squares of log e against log h over all levels).
 # Usage (from the repository root): bash scripts/mesh-convergence.sh
 #   LEVELS="1 2 3" FAMILIES="rect_tri disc" OUT=out/mesh-convergence DOC=docs/mesh-convergence.md
+#   PERITHERM=target/release/peritherm   (skip the build, use this binary)
 # Release build first (uses $CARGO_TARGET_DIR if set); about 10 min on 2 cores with level 4.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,8 +16,12 @@ LEVELS=${LEVELS:-"1 2 3 4"}
 FAMILIES=${FAMILIES:-"rect_tri rect_quad graded disc cube_tet"}
 OUT=${OUT:-out/mesh-convergence}
 DOC=${DOC:-docs/mesh-convergence.md}
-cargo build --release --quiet
-bin=${CARGO_TARGET_DIR:-target}/release/peritherm
+if [ -n "${PERITHERM:-}" ]; then
+  bin=$PERITHERM           # an already built binary (e.g. from `cargo test --release`)
+else
+  cargo build --release --quiet
+  bin=${CARGO_TARGET_DIR:-target}/release/peritherm
+fi
 mkdir -p "$OUT"
 for fam in $FAMILIES; do
   files=""
