@@ -393,12 +393,9 @@ impl Reference {
                 edge,
                 initial,
             } => {
-                let p = [x, y, z];
-                let mut u = 1.0;
-                for k in 0..ends.len().min(3) {
-                    u *= axis_factor(ends[k], p[k] - min[k], size[k], a, t);
-                }
-                edge + (initial - edge) * u
+                let u = (0..ends.len().min(3))
+                    .map(|k| axis_factor(ends[k], [x, y, z][k] - min[k], size[k], a, t));
+                edge + (initial - edge) * u.product::<f64>()
             }
             Reference::DiscFixedEdge {
                 radius,

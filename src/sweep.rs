@@ -270,7 +270,8 @@ pub fn csv(rows: &[Row]) -> String {
         s.push_str(k);
         s.push(',');
     }
-    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,h_mean,time,max_abs,mean_abs,eq13,epsilon,l2_rel,against\n");
+    // h_mean and l2_rel come last: readers of the older columns by position keep working
+    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,time,max_abs,mean_abs,eq13,epsilon,against,h_mean,l2_rel\n");
     for r in rows {
         s.push_str(&r.label);
         s.push(',');
@@ -279,21 +280,21 @@ pub fn csv(rows: &[Row]) -> String {
             s.push(',');
         }
         s.push_str(&format!(
-            "{},{},{},{:.3},{:e},{},{:e},{},{:e},{},{},{},{},{}\n",
+            "{},{},{},{:.3},{:e},{},{},{:e},{},{},{},{},{:e},{}\n",
             r.nodes,
             r.bonds,
             r.steps,
             r.wall_seconds,
             r.delta_min,
             r.ratio,
-            r.h_mean,
             r.time,
             r.max_abs,
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
-            opt(r.l2_rel),
-            r.against
+            r.against,
+            r.h_mean,
+            opt(r.l2_rel)
         ));
     }
     s
@@ -478,12 +479,10 @@ fn file_name(path: &Path) -> String {
 /// The abscissa of a convergence plot: a row's value on it, if any.
 type Axis = Box<dyn Fn(&Row) -> Option<f64>>;
 
-/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
-/// eq 13 where there is one) against each varied key whose values are positive numbers, and
-/// against the smallest horizon δ when it varies, on log–log axes with fitted rates (seed 000
-/// Figs 10–12, seed 003 Figs 11–12). Returns the stems written and the fitted rates as
-/// (stem, series, rate).
-pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+/// The abscissae of the convergence plots: each varied key whose values are numbers, δ_min
+/// unless a varied key is proportional to it, and the mean spacing h unless a varied key is
+/// proportional to it (a spacing sweep).
+fn plot_axes(rows: &[Row]) -> Vec<(String, Axis)> {
     let mut axes: Vec<(String, Axis)> = Vec::new();
     let keys: Vec<String> = rows
         .first()
@@ -520,6 +519,15 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
             Box::new(|r: &Row| Some(r.h_mean)),
         ));
     }
+    axes
+}
+
+/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
+/// eq 13 and the relative L2 error where there are) against each axis of `plot_axes` along
+/// which the rows differ, on log–log axes with fitted rates (seed 000 Figs 10–12, seed 003
+/// Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
+pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+    let axes = plot_axes(rows);
     let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
     times.sort_by(f64::total_cmp);
     times.dedup();

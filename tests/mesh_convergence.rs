@@ -128,3 +128,46 @@ fn disc_converges() {
 fn cube_tet_converges() {
     converges("cube_tet", false);
 }
+
+/// `peritherm sweep --vary mesh.file=...` runs the levels of a family (the script's path):
+/// one row per level whose h and relative L2 error are the ones measured here on the same
+/// cloud and written to the level's run.json, and a convergence plot against h.
+#[test]
+fn sweep_varies_the_mesh_file() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let files: Vec<String> = [1, 2]
+        .iter()
+        .map(|l| format!("../meshes/conv_rect_quad_L{l}.msh"))
+        .collect();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_peritherm"))
+        .arg("sweep")
+        .arg(root.join("cases/conv_rect_quad.toml"))
+        .arg("--vary")
+        .arg(format!("mesh.file={}", files.join(",")))
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for (level, row) in [1, 2].iter().zip(&rows) {
+        let (h, n) = spacing(&case_at("rect_quad", *level));
+        let h_row: f64 = row[col("h_mean")].parse().unwrap();
+        assert!((h_row / h - 1.0).abs() < 1e-9, "L{level}: h {h_row} vs {h}");
+        assert_eq!(row[col("nodes")], n.to_string());
+        let run = peritherm::output::RunSummary::read(&dir.path().join(row[0])).unwrap();
+        let e: f64 = row[col("l2_rel")].parse().unwrap();
+        let want = run.reference.last().unwrap().l2_rel_volume;
+        assert!(
+            e > 0.0 && (e / want - 1.0).abs() < 1e-9,
+            "L{level}: {e} vs {want}"
+        );
+    }
+    assert!(dir.path().join("convergence_h_t1.png").exists());
+}
