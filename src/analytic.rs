@@ -1,10 +1,26 @@
 //! Classical (local) series solutions of the papers' benchmarks, for comparison.
 //!
-//! All are separation-of-variables series of the heat equation θ_t = α ∇²θ along one axis
-//! (or two, for the square), written in the coordinate s = x − x0 along the bar.
+//! All are separation-of-variables series of the heat equation θ_t = α ∇²θ: along one axis
+//! (written in the coordinate s = x − x0 along the bar), products of such slabs over the axes
+//! of a rectangle or box, and radial series of a sphere and a disc.
 
+use crate::math::Point;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+
+/// The two ends of one axis of a [`Reference::BoxFixedFaces`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisEnds {
+    /// Both faces of the axis held: the slab series on [0, L].
+    FixedBoth,
+    /// The low face held, the high face insulated: a slab of length 2L at s.
+    FixedLow,
+    /// The low face insulated, the high face held: a slab of length 2L at s + L.
+    FixedHigh,
+    /// Both faces insulated: the axis contributes a factor 1.
+    Insulated,
+}
 
 /// A classical reference solution with its parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -85,7 +101,7 @@ pub enum Reference {
     },
     /// Sphere of radius R about the origin, surface held, uniform initial temperature
     /// (seed 001 §3.2): θ = θ_s + (θ_0 − θ_s)(2R/(πr)) Σ (−1)^(n+1)/n sin(nπr/R)
-    /// e^(−α n²π² t/R²), r = √(x² + y²) (the radius of a 1D radial model is x).
+    /// e^(−α n²π² t/R²), r = √(x² + y² + z²) (the radius of a 1D radial model is x).
     SphereFixedSurface {
         /// Radius R, m.
         radius: f64,
@@ -121,6 +137,36 @@ pub enum Reference {
         /// C_m, J/(kg·K).
         melted_specific_heat: f64,
     },
+    /// A rectangle [x0, x0 + a] × [y0, y0 + b] (or box × [z0, z0 + c], or bar) with every face
+    /// either held at `edge` or insulated, uniform initial θ0: θ = θ_edge + (θ0 − θ_edge)
+    /// Π_axes u(s_axis, t), u the unit slab series of each axis ([`AxisEnds`]).
+    BoxFixedFaces {
+        /// Lower corner (x0, y0[, z0]), m: one number per axis of the box (1 to 3).
+        min: Vec<f64>,
+        /// Side lengths (a, b[, c]), m: one per axis.
+        size: Vec<f64>,
+        /// How each axis is bounded at its low and high faces: one per axis.
+        ends: Vec<AxisEnds>,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ on the held faces, °C.
+        edge: f64,
+        /// Initial θ, °C.
+        initial: f64,
+    },
+    /// Disc of radius R about the origin (a cylinder along z in 3D), edge held, uniform
+    /// initial θ0: θ = θ_s + (θ0 − θ_s) Σ 2/(λ_n J1(λ_n)) J0(λ_n r/R) e^(−α λ_n² t/R²),
+    /// λ_n the zeros of J0 ([`bessel_j0_zeros`]), r = √(x² + y²).
+    DiscFixedEdge {
+        /// Radius R, m.
+        radius: f64,
+        /// Diffusivity α, m²/s.
+        diffusivity: f64,
+        /// θ on the edge r = R, °C.
+        edge: f64,
+        /// Initial θ, °C.
+        initial: f64,
+    },
     /// Steady conduction in a ring about the origin with both circles held:
     /// θ = θ_i + (θ_o − θ_i) ln(r/r_i)/ln(r_o/r_i) (independent of t).
     AnnulusSteady {
@@ -155,6 +201,56 @@ fn slab(s: f64, l: f64, alpha: f64, t: f64) -> f64 {
         sum += (lam * s).sin() / m as f64 * (-alpha * lam * lam * t).exp();
     }
     4.0 / PI * sum
+}
+
+/// The unit solution of one axis of a [`Reference::BoxFixedFaces`] at s ∈ [0, L] (1 inside
+/// at t = 0, 0 on the held faces).
+fn axis_factor(ends: AxisEnds, s: f64, l: f64, alpha: f64, t: f64) -> f64 {
+    let s = s.clamp(0.0, l);
+    match ends {
+        AxisEnds::FixedBoth => slab(s, l, alpha, t),
+        // the slab [0, 2L] held at both ends is symmetric about L: insulated there
+        AxisEnds::FixedLow => slab(s, 2.0 * l, alpha, t),
+        AxisEnds::FixedHigh => slab(s + l, 2.0 * l, alpha, t),
+        AxisEnds::Insulated => 1.0,
+    }
+}
+
+/// The first `n` positive zeros of the Bessel function J0, in increasing order: Newton's
+/// method (J0' = −J1) from McMahon's asymptotic expansion β + 1/(8β) − 31/(384β³) +
+/// 3779/(15360β⁵), β = (n − ¼)π (Abramowitz & Stegun 9.5.12), to 1e-15 relative.
+pub fn bessel_j0_zeros(n: usize) -> Vec<f64> {
+    (1..=n)
+        .map(|k| {
+            let b = (k as f64 - 0.25) * PI;
+            let mut z =
+                b + 1.0 / (8.0 * b) - 31.0 / (384.0 * b.powi(3)) + 3779.0 / (15360.0 * b.powi(5));
+            for _ in 0..50 {
+                let step = libm::j0(z) / libm::j1(z);
+                z += step;
+                if step.abs() <= 1e-15 * z {
+                    break;
+                }
+            }
+            z
+        })
+        .collect()
+}
+
+/// The unit solution of a disc of radius R with its edge held at 0, at radius r: Σ
+/// 2/(λ_n J1(λ_n)) J0(λ_n r/R) e^(−α λ_n² t/R²), to the terms with e^(−α λ_n² t/R²) ≥ e^(−40).
+fn disc(r: f64, radius: f64, alpha: f64, t: f64) -> f64 {
+    let rho = (r / radius).clamp(0.0, 1.0);
+    if t <= 0.0 {
+        return if rho < 1.0 { 1.0 } else { 0.0 };
+    }
+    let tau = alpha * t / (radius * radius);
+    // λ_n ≈ (n − ¼)π: the last term needed has λ_n² τ ≥ 40
+    let n = ((40.0 / tau).sqrt() / PI + 0.25).ceil() as usize + 2;
+    bessel_j0_zeros(n.clamp(4, 100_000))
+        .into_iter()
+        .map(|l| 2.0 / (l * libm::j1(l)) * libm::j0(l * rho) * (-l * l * tau).exp())
+        .sum()
 }
 
 /// Neumann's root λ and the frozen and melted diffusivities (α_f, α_m) of a
@@ -209,28 +305,66 @@ pub fn neumann_front(r: &Reference, t: f64) -> Option<f64> {
 }
 
 impl Reference {
-    /// True when the solution varies with y as well as x.
-    pub fn depends_on_y(&self) -> bool {
-        matches!(
-            self,
+    /// Which of x, y, z the solution varies with.
+    pub fn depends_on(&self) -> [bool; 3] {
+        match self {
             Reference::SquareFixedEdges { .. }
-                | Reference::AnnulusSteady { .. }
-                | Reference::SphereFixedSurface { .. }
-        )
+            | Reference::AnnulusSteady { .. }
+            | Reference::DiscFixedEdge { .. } => [true, true, false],
+            Reference::SphereFixedSurface { .. } => [true, true, true],
+            Reference::BoxFixedFaces { ends, .. } => {
+                let mut d = [false; 3];
+                for (a, e) in ends.iter().enumerate().take(3) {
+                    d[a] = *e != AxisEnds::Insulated;
+                }
+                d
+            }
+            _ => [true, false, false],
+        }
     }
 
-    /// The classical temperature at every point, evaluating each distinct (x, y) once
-    /// (in parallel), °C.
-    pub fn eval_many(&self, points: &[(f64, f64)], t: f64) -> Vec<f64> {
+    /// The parameters a series cannot be evaluated with, as a message (`None`: usable).
+    pub fn check(&self) -> Option<String> {
+        match self {
+            Reference::BoxFixedFaces {
+                min,
+                size,
+                ends,
+                diffusivity,
+                ..
+            } => {
+                let d = min.len();
+                if !(1..=3).contains(&d) || size.len() != d || ends.len() != d {
+                    return Some(format!(
+                        "min, size and ends need one entry per axis (1 to 3), got {}, {} and {}",
+                        d,
+                        size.len(),
+                        ends.len()
+                    ));
+                }
+                if size.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+                    return Some(format!("every size must be > 0, got {size:?}"));
+                }
+                positive("diffusivity", *diffusivity)
+            }
+            Reference::DiscFixedEdge {
+                radius,
+                diffusivity,
+                ..
+            } => positive("radius", *radius).or_else(|| positive("diffusivity", *diffusivity)),
+            _ => None,
+        }
+    }
+
+    /// The classical temperature at every point, evaluating each distinct point once (only
+    /// the coordinates the solution depends on count; in parallel), °C.
+    pub fn eval_many(&self, points: &[Point], t: f64) -> Vec<f64> {
         use rayon::prelude::*;
         use std::collections::HashMap;
-        let key = |&(x, y): &(f64, f64)| {
-            (
-                x.to_bits(),
-                if self.depends_on_y() { y.to_bits() } else { 0 },
-            )
-        };
-        let mut index: HashMap<(u64, u64), usize> = HashMap::new();
+        let dep = self.depends_on();
+        let bits = |v: f64, a: usize| if dep[a] { v.to_bits() } else { 0 };
+        let key = |p: &Point| (bits(p.x, 0), bits(p.y, 1), bits(p.z, 2));
+        let mut index: HashMap<(u64, u64, u64), usize> = HashMap::new();
         let mut unique = Vec::new();
         let slots: Vec<usize> = points
             .iter()
@@ -243,21 +377,39 @@ impl Reference {
             .collect();
         let values: Vec<f64> = unique
             .par_iter()
-            .map(|&(x, y)| self.eval(x, y, t))
+            .map(|p: &Point| self.eval(p.x, p.y, p.z, t))
             .collect();
         slots.into_iter().map(|s| values[s]).collect()
     }
 
-    /// The classical temperature at a point and time, °C.
-    pub fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
+    /// The classical temperature at the point (x, y, z), m, and time t, s, °C.
+    pub fn eval(&self, x: f64, y: f64, z: f64, t: f64) -> f64 {
         match *self {
+            Reference::BoxFixedFaces {
+                ref min,
+                ref size,
+                ref ends,
+                diffusivity: a,
+                edge,
+                initial,
+            } => {
+                let u = (0..ends.len().min(3))
+                    .map(|k| axis_factor(ends[k], [x, y, z][k] - min[k], size[k], a, t));
+                edge + (initial - edge) * u.product::<f64>()
+            }
+            Reference::DiscFixedEdge {
+                radius,
+                diffusivity: a,
+                edge,
+                initial,
+            } => edge + (initial - edge) * disc(x.hypot(y), radius, a, t),
             Reference::SphereFixedSurface {
                 radius: rs,
                 diffusivity: a,
                 surface,
                 initial,
             } => {
-                let r = x.hypot(y).min(rs);
+                let r = x.hypot(y).hypot(z).min(rs);
                 let c = PI / rs;
                 let mut sum = 0.0;
                 for n in 1..=terms(a, t, c) {
@@ -395,6 +547,11 @@ impl Reference {
     }
 }
 
+/// "`name` must be > 0" unless `v` is a positive finite number.
+fn positive(name: &str, v: f64) -> Option<String> {
+    (!(v.is_finite() && v > 0.0)).then(|| format!("{name} must be > 0, got {v}"))
+}
+
 /// ∫_0^t e^(−μ(t−τ)) g'(τ) dτ for g = A τ e^(−rτ).
 fn duhamel(amp: f64, r: f64, mu: f64, t: f64) -> f64 {
     let nu = mu - r;
@@ -450,7 +607,7 @@ mod tests {
             for i in [1, n / 4, n / 2, 3 * n / 4] {
                 let r = i as f64 * h;
                 let fd = u[i] / r;
-                let series = sphere.eval(r, 0.0, t);
+                let series = sphere.eval(r, 0.0, 0.0, t);
                 assert!(
                     (fd - series).abs() < 2e-3 * (t0 - ts),
                     "t = {t}, r = {r}: FD {fd}, series {series}"
@@ -458,8 +615,8 @@ mod tests {
             }
         }
         // the centre is finite and the surface is held
-        assert!(sphere.eval(0.0, 0.0, 1.0).is_finite());
-        assert!((sphere.eval(rs, 0.0, 1.0) - ts).abs() < 1e-9 * t0);
+        assert!(sphere.eval(0.0, 0.0, 0.0, 1.0).is_finite());
+        assert!((sphere.eval(rs, 0.0, 0.0, 1.0) - ts).abs() < 1e-9 * t0);
     }
 
     /// Seed 000's printed midpoint values at t = 8 s (±0.005 °C: the paper prints 2 decimals).
@@ -474,9 +631,9 @@ mod tests {
             initial: 100.0,
         };
         assert!(
-            (ex1.eval(5.0, 0.0, 8.0) - 51.75).abs() < 0.005,
+            (ex1.eval(5.0, 0.0, 0.0, 8.0) - 51.75).abs() < 0.005,
             "{}",
-            ex1.eval(5.0, 0.0, 8.0)
+            ex1.eval(5.0, 0.0, 0.0, 8.0)
         );
         let ex2 = Reference::BarInsulatedLeft {
             x0: 0.0,
@@ -487,9 +644,9 @@ mod tests {
             initial_right: 0.0,
         };
         assert!(
-            (ex2.eval(5.0, 0.0, 8.0) - 53.06).abs() < 0.005,
+            (ex2.eval(5.0, 0.0, 0.0, 8.0) - 53.06).abs() < 0.005,
             "{}",
-            ex2.eval(5.0, 0.0, 8.0)
+            ex2.eval(5.0, 0.0, 0.0, 8.0)
         );
     }
 
@@ -504,10 +661,10 @@ mod tests {
             gradient: 3.0,
             initial: 0.0,
         };
-        assert!(ex3.eval(1.0, 0.0, 1e-6).abs() < 1e-2);
-        assert!((ex3.eval(0.0, 0.0, 0.5) - 20.0).abs() < 1e-9);
+        assert!(ex3.eval(1.0, 0.0, 0.0, 1e-6).abs() < 1e-2);
+        assert!((ex3.eval(0.0, 0.0, 0.0, 0.5) - 20.0).abs() < 1e-9);
         let h = 1e-5;
-        let grad = (ex3.eval(PI, 0.0, 0.5) - ex3.eval(PI - h, 0.0, 0.5)) / h;
+        let grad = (ex3.eval(PI, 0.0, 0.0, 0.5) - ex3.eval(PI - h, 0.0, 0.0, 0.5)) / h;
         assert!((grad - 3.0).abs() < 1e-3, "{grad}");
         let shock = Reference::BarPulseLeft {
             x0: -5.0,
@@ -517,8 +674,8 @@ mod tests {
             rate: 2.0,
         };
         let t: f64 = 0.8;
-        assert!((shock.eval(-5.0, 0.0, t) - 5.0 * t * (-2.0 * t).exp()).abs() < 1e-9);
-        assert!(shock.eval(4.0, 0.0, 0.3).abs() < 1e-6);
+        assert!((shock.eval(-5.0, 0.0, 0.0, t) - 5.0 * t * (-2.0 * t).exp()).abs() < 1e-9);
+        assert!(shock.eval(4.0, 0.0, 0.0, 0.3).abs() < 1e-6);
         let sq = Reference::SquareFixedEdges {
             x0: 0.0,
             y0: 0.0,
@@ -527,8 +684,8 @@ mod tests {
             edge: 0.0,
             initial: 40.0,
         };
-        assert!((sq.eval(0.5, 0.5, 1e-7) - 40.0).abs() < 1e-3);
-        assert!(sq.eval(0.0, 0.3, 0.01).abs() < 1e-12);
+        assert!((sq.eval(0.5, 0.5, 0.0, 1e-7) - 40.0).abs() < 1e-3);
+        assert!(sq.eval(0.0, 0.3, 0.0, 0.01).abs() < 1e-12);
     }
 
     /// The Duhamel series against a fine explicit finite-difference solve (tolerance 2e-3 °C
@@ -560,7 +717,7 @@ mod tests {
             rate: 2.0,
         };
         for i in (0..=n).step_by(10) {
-            let e = r.eval(i as f64 * h, 0.0, 3.0);
+            let e = r.eval(i as f64 * h, 0.0, 0.0, 3.0);
             assert!(
                 (e - u[i]).abs() < 2e-3,
                 "x = {}: {} vs {}",
@@ -569,6 +726,125 @@ mod tests {
                 u[i]
             );
         }
+    }
+
+    /// The zeros of J0: J0 vanishes there to round-off, they interlace with the zeros of J1
+    /// (J1 changes sign between consecutive ones), their spacing tends to π, and the first
+    /// is A&S Table 9.5's 2.404825557695773 (to 1e-14).
+    #[test]
+    fn bessel_zeros_are_zeros() {
+        let z = bessel_j0_zeros(400);
+        assert!((z[0] - 2.404825557695773).abs() < 1e-14, "{}", z[0]);
+        for w in z.windows(2) {
+            assert!(w[1] > w[0]);
+            assert!(libm::j1(w[0]) * libm::j1(w[1]) < 0.0);
+        }
+        for &x in &z {
+            // |J0| near a zero is |J1(x)|·|x − zero|: round-off of x is 1e-16 x
+            assert!(libm::j0(x).abs() < 1e-15 * x.max(1.0), "J0({x})");
+        }
+        assert!((z[399] - z[398] - PI).abs() < 1e-5);
+    }
+
+    /// The disc series meets its data: the edge is held, the initial field is uniform (the
+    /// series Σ 2J0(λr/R)/(λJ1(λ)) → 1 inside as t → 0, to 1e-3 at t = 1e-6 R²/α away from
+    /// the edge), the field is radial and it decays as the first mode e^(−λ1²αt/R²) late.
+    #[test]
+    fn disc_series_meets_its_data() {
+        let d = Reference::DiscFixedEdge {
+            radius: 0.5,
+            diffusivity: 2.0,
+            edge: 10.0,
+            initial: 60.0,
+        };
+        assert!((d.eval(0.5, 0.0, 0.0, 0.01) - 10.0).abs() < 1e-12);
+        assert!((d.eval(0.0, -0.5, 0.0, 0.01) - 10.0).abs() < 1e-12);
+        for r in [0.0, 0.1, 0.3, 0.45] {
+            assert!((d.eval(r, 0.0, 0.0, 1e-6 * 0.25 / 2.0) - 60.0).abs() < 1e-3 * 50.0);
+        }
+        let (a, b) = (d.eval(0.3, 0.0, 0.0, 0.02), d.eval(0.18, 0.24, 5.0, 0.02));
+        assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        let l1 = bessel_j0_zeros(1)[0];
+        let late = |t: f64| d.eval(0.0, 0.0, 0.0, t) - 10.0;
+        let ratio = late(0.2) / late(0.1);
+        let mode = (-l1 * l1 * 2.0 * 0.1 / 0.25).exp();
+        assert!((ratio / mode - 1.0).abs() < 1e-6, "{ratio} vs {mode}");
+    }
+
+    /// The box series meets its data: held faces at the edge value, a zero normal derivative
+    /// at insulated faces (one-sided difference, h = 1e-6), the initial value inside at small
+    /// t, an insulated axis contributing nothing, and the product of per-axis slab factors.
+    #[test]
+    fn box_series_meets_its_data() {
+        let ends = vec![AxisEnds::FixedBoth, AxisEnds::FixedLow, AxisEnds::FixedHigh];
+        let b = Reference::BoxFixedFaces {
+            min: vec![1.0, -1.0, 0.0],
+            size: vec![2.0, 1.0, 0.5],
+            ends,
+            diffusivity: 0.5,
+            edge: -5.0,
+            initial: 20.0,
+        };
+        let t = 0.02;
+        for p in [
+            [1.0, -0.5, 0.2],
+            [3.0, -0.5, 0.2],
+            [2.0, -1.0, 0.2],
+            [2.0, -0.5, 0.5],
+        ] {
+            assert!((b.eval(p[0], p[1], p[2], t) + 5.0).abs() < 1e-9, "{p:?}");
+        }
+        let h = 1e-6;
+        let dy = (b.eval(2.0, 0.0, 0.2, t) - b.eval(2.0, -h, 0.2, t)) / h;
+        let dz = (b.eval(2.0, -0.5, h, t) - b.eval(2.0, -0.5, 0.0, t)) / h;
+        assert!(dy.abs() < 1e-3 && dz.abs() < 1e-3, "{dy} {dz}");
+        assert!((b.eval(2.0, -0.5, 0.25, 1e-9) - 20.0).abs() < 1e-6);
+        let x_only = Reference::BoxFixedFaces {
+            min: vec![1.0, -1.0],
+            size: vec![2.0, 1.0],
+            ends: vec![AxisEnds::FixedBoth, AxisEnds::Insulated],
+            diffusivity: 0.5,
+            edge: 0.0,
+            initial: 1.0,
+        };
+        let bar = Reference::BarFixedEnds {
+            x0: 1.0,
+            length: 2.0,
+            diffusivity: 0.5,
+            left: 0.0,
+            right: 0.0,
+            initial: 1.0,
+        };
+        for x in [1.1, 1.7, 2.5] {
+            let (u, v) = (x_only.eval(x, 7.0, 0.0, t), bar.eval(x, 0.0, 0.0, t));
+            assert!((u - v).abs() < 1e-12, "{u} vs {v}");
+        }
+        assert_eq!(x_only.depends_on(), [true, false, false]);
+        assert_eq!(b.depends_on(), [true, true, true]);
+    }
+
+    /// Box and disc parameters that no series has are named.
+    #[test]
+    fn bad_series_parameters_are_named() {
+        let b = Reference::BoxFixedFaces {
+            min: vec![0.0, 0.0],
+            size: vec![1.0],
+            ends: vec![AxisEnds::FixedBoth, AxisEnds::FixedLow],
+            diffusivity: 1.0,
+            edge: 0.0,
+            initial: 1.0,
+        };
+        assert!(b.check().unwrap().contains("one entry per axis"));
+        let d = Reference::DiscFixedEdge {
+            radius: -1.0,
+            diffusivity: 1.0,
+            edge: 0.0,
+            initial: 1.0,
+        };
+        assert!(d.check().unwrap().contains("radius must be > 0"));
+        let text = "kind = \"box_fixed_faces\"\nmin = [0.0]\nsize = [1.0]\nends = [\"fixed_low\"]\ndiffusivity = 1.0\nedge = 0.0\ninitial = 1.0\n";
+        let r: Reference = toml::from_str(text).unwrap();
+        assert_eq!(r.check(), None);
     }
 
     fn water_freezing() -> Reference {
@@ -595,10 +871,10 @@ mod tests {
         let t = 36_000.0;
         let x = super::neumann_front(&r, t).unwrap();
         let h = 1e-7;
-        assert!((r.eval(x - 1e-12, 0.0, t) - 273.15).abs() < 1e-6);
-        assert!((r.eval(x + 1e-12, 0.0, t) - 273.15).abs() < 1e-6);
-        let gs = (r.eval(x - h, 0.0, t) - r.eval(x - 3.0 * h, 0.0, t)) / (2.0 * h);
-        let gl = (r.eval(x + 3.0 * h, 0.0, t) - r.eval(x + h, 0.0, t)) / (2.0 * h);
+        assert!((r.eval(x - 1e-12, 0.0, 0.0, t) - 273.15).abs() < 1e-6);
+        assert!((r.eval(x + 1e-12, 0.0, 0.0, t) - 273.15).abs() < 1e-6);
+        let gs = (r.eval(x - h, 0.0, 0.0, t) - r.eval(x - 3.0 * h, 0.0, 0.0, t)) / (2.0 * h);
+        let gl = (r.eval(x + 3.0 * h, 0.0, 0.0, t) - r.eval(x + h, 0.0, 0.0, t)) / (2.0 * h);
         let lhs = 2.14 * gs - 0.6 * gl;
         let dt = 1.0;
         let v = (super::neumann_front(&r, t + dt).unwrap()
@@ -607,7 +883,7 @@ mod tests {
         let rhs = 1000.0 * 333e3 * v;
         assert!((lhs - rhs).abs() < 1e-5 * rhs, "{lhs} vs {rhs}");
         // far away the liquid is untouched, at the face the surface temperature holds
-        assert!((r.eval(5.0, 0.0, t) - 278.15).abs() < 1e-9);
-        assert!((r.eval(0.0, 0.0, t) - 263.15).abs() < 1e-12);
+        assert!((r.eval(5.0, 0.0, 0.0, t) - 278.15).abs() < 1e-9);
+        assert!((r.eval(0.0, 0.0, 0.0, t) - 263.15).abs() < 1e-12);
     }
 }

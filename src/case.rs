@@ -525,7 +525,12 @@ fn reference(
         }
     }
     let source = match (r.solution, r.file, r.fem) {
-        (Some(s), None, None) => ReferenceSource::Analytic(s),
+        (Some(s), None, None) => {
+            if let Some(m) = s.check() {
+                return Err(case_err(path, "reference.solution", m));
+            }
+            ReferenceSource::Analytic(s)
+        }
         (None, None, Some(f)) => {
             for (key, v) in [("reference.fem.h", f.h), ("reference.fem.dt", f.dt)] {
                 if let Some(v) = v {

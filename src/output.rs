@@ -273,6 +273,10 @@ pub struct Comparison {
     pub l2_rel_line: f64,
     /// Seed 001 eq 27: rms difference / max |θ_c|.
     pub epsilon: f64,
+    /// Relative L2 error over all body nodes compared, weighted by node volume:
+    /// √(Σ V_i (θ_pd − θ_c)² / Σ V_i θ_c²), dimensionless (0 where θ_c ≡ 0).
+    #[serde(default)]
+    pub l2_rel_volume: f64,
     /// Nodes on the probe line.
     pub line_nodes: usize,
     /// The body node nearest to the reference's probe point, if one is set.

@@ -237,6 +237,9 @@ pub struct Row {
     pub delta_min: f64,
     /// δ/Δ at the node with the smallest horizon.
     pub ratio: f64,
+    /// Mean node spacing h = (Σ V_i / (τ N))^(1/d) over the N body nodes, m (τ the 2D
+    /// thickness or 1D area; axisymmetric volumes carry their 2πr).
+    pub h_mean: f64,
     /// Output time, s.
     pub time: f64,
     /// max |θ − θ_ref| over the body nodes compared, °C.
@@ -248,6 +251,9 @@ pub struct Row {
     /// Seed 001 eq 27: rms difference / max |θ_ref| (the other run's field is the reference
     /// when comparing with a run).
     pub epsilon: Option<f64>,
+    /// Volume-weighted relative L2 error over all body nodes, ‖θ − θ_ref‖/‖θ_ref‖
+    /// (classical references only), dimensionless.
+    pub l2_rel: Option<f64>,
     /// What it is compared with.
     pub against: String,
 }
@@ -264,7 +270,8 @@ pub fn csv(rows: &[Row]) -> String {
         s.push_str(k);
         s.push(',');
     }
-    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,time,max_abs,mean_abs,eq13,epsilon,against\n");
+    // h_mean and l2_rel come last: readers of the older columns by position keep working
+    s.push_str("nodes,bonds,steps,wall_seconds,delta_min,ratio,time,max_abs,mean_abs,eq13,epsilon,against,h_mean,l2_rel\n");
     for r in rows {
         s.push_str(&r.label);
         s.push(',');
@@ -273,7 +280,7 @@ pub fn csv(rows: &[Row]) -> String {
             s.push(',');
         }
         s.push_str(&format!(
-            "{},{},{},{:.3},{:e},{},{},{:e},{},{},{},{}\n",
+            "{},{},{},{:.3},{:e},{},{},{:e},{},{},{},{},{:e},{}\n",
             r.nodes,
             r.bonds,
             r.steps,
@@ -285,7 +292,9 @@ pub fn csv(rows: &[Row]) -> String {
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
-            r.against
+            r.against,
+            r.h_mean,
+            opt(r.l2_rel)
         ));
     }
     s
@@ -301,11 +310,11 @@ pub fn markdown(rows: &[Row]) -> String {
     for k in &keys {
         s.push_str(&format!(" {k} |"));
     }
-    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | against |\n|---|");
+    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | h (m) | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | rel. L2 | against |\n|---|");
     for _ in &keys {
         s.push_str("---|");
     }
-    s.push_str("---|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str("---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     let opt = |v: Option<f64>| v.map(|x| format!("{x:.3e}")).unwrap_or_else(|| "-".into());
     for r in rows {
         s.push_str(&format!("| {} |", r.label));
@@ -313,17 +322,19 @@ pub fn markdown(rows: &[Row]) -> String {
             s.push_str(&format!(" {v} |"));
         }
         s.push_str(&format!(
-            " {} | {} | {:.3e} | {:.3} | {:.1} | {} | {:.3e} | {} | {} | {} | {} |\n",
+            " {} | {} | {:.3e} | {:.3} | {:.3e} | {:.1} | {} | {:.3e} | {} | {} | {} | {} | {} |\n",
             r.nodes,
             r.bonds,
             r.delta_min,
             r.ratio,
+            r.h_mean,
             r.wall_seconds,
             r.time,
             r.max_abs,
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
+            opt(r.l2_rel),
             r.against
         ));
     }
@@ -370,6 +381,8 @@ pub fn run(
             run_case(&v.case, &dir, |_, _| {})?
         };
         let cloud = v.case.spec.geometry.bare_cloud()?;
+        let measure: f64 = cloud.volume[..cloud.n_body].iter().sum::<f64>() / cloud.tau;
+        let h_mean = (measure / cloud.n_body.max(1) as f64).powf(1.0 / cloud.dim as f64);
         let finest = (0..cloud.n_body)
             .min_by(|&a, &b| cloud.horizon[a].total_cmp(&cloud.horizon[b]))
             .unwrap_or(0);
@@ -382,11 +395,13 @@ pub fn run(
             wall_seconds: summary.setup_seconds + summary.wall_seconds,
             delta_min: cloud.horizon[finest],
             ratio: cloud.horizon[finest] / cloud.spacing[finest],
+            h_mean,
             time: 0.0,
             max_abs: 0.0,
             mean_abs: None,
             eq13: None,
             epsilon: None,
+            l2_rel: None,
             against: String::new(),
         };
         let reference_dir = match against {
@@ -406,6 +421,7 @@ pub fn run(
                         max_abs: c.max_abs_diff,
                         eq13: Some(c.l2_rel_line),
                         epsilon: Some(c.epsilon),
+                        l2_rel: Some(c.l2_rel_volume),
                         against: "reference".into(),
                         ..base.clone()
                     });
@@ -463,12 +479,10 @@ fn file_name(path: &Path) -> String {
 /// The abscissa of a convergence plot: a row's value on it, if any.
 type Axis = Box<dyn Fn(&Row) -> Option<f64>>;
 
-/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
-/// eq 13 where there is one) against each varied key whose values are positive numbers, and
-/// against the smallest horizon δ when it varies, on log–log axes with fitted rates (seed 000
-/// Figs 10–12, seed 003 Figs 11–12). Returns the stems written and the fitted rates as
-/// (stem, series, rate).
-pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+/// The abscissae of the convergence plots: each varied key whose values are numbers, δ_min
+/// unless a varied key is proportional to it, and the mean spacing h unless a varied key is
+/// proportional to it (a spacing sweep).
+fn plot_axes(rows: &[Row]) -> Vec<(String, Axis)> {
     let mut axes: Vec<(String, Axis)> = Vec::new();
     let keys: Vec<String> = rows
         .first()
@@ -491,6 +505,29 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
     if !(0..keys.len()).any(proportional) {
         axes.push(("δ_min (m)".into(), Box::new(|r: &Row| Some(r.delta_min))));
     }
+    // the mean spacing, unless a varied key is proportional to it (a spacing sweep)
+    let follows_h = |i: usize| {
+        let ratios: Vec<f64> = rows
+            .iter()
+            .filter_map(|r| Some(r.settings[i].1.parse::<f64>().ok()? / r.h_mean))
+            .collect();
+        ratios.len() == rows.len() && ratios.iter().all(|q| (q / ratios[0] - 1.0).abs() < 1e-6)
+    };
+    if !(0..keys.len()).any(follows_h) {
+        axes.push((
+            "h = (V/N)^(1/d) (m)".into(),
+            Box::new(|r: &Row| Some(r.h_mean)),
+        ));
+    }
+    axes
+}
+
+/// Convergence plots of a sweep into `out`, one per output time: the max difference (and
+/// eq 13 and the relative L2 error where there are) against each axis of `plot_axes` along
+/// which the rows differ, on log–log axes with fitted rates (seed 000 Figs 10–12, seed 003
+/// Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
+pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
+    let axes = plot_axes(rows);
     let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
     times.sort_by(f64::total_cmp);
     times.dedup();
@@ -523,6 +560,18 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
                     .colour(1),
                 );
             }
+            if at.iter().all(|r| r.l2_rel.is_some_and(|e| e > 0.0)) {
+                series.push(
+                    Series::new(
+                        "relative L2",
+                        xs.iter()
+                            .zip(&at)
+                            .map(|(x, r)| (*x, r.l2_rel.unwrap_or(0.0)))
+                            .collect(),
+                    )
+                    .colour(2),
+                );
+            }
             series.retain(|s| s.points.iter().all(|p| p.1 > 0.0));
             if series.is_empty() {
                 continue;
@@ -530,6 +579,8 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
             let short = name.rsplit('.').next().unwrap_or(name);
             let slug: String = if short.starts_with('δ') {
                 "delta".into()
+            } else if short.starts_with("h = ") {
+                "h".into()
             } else {
                 short
                     .chars()

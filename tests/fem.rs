@@ -49,8 +49,8 @@ fn max_error(c: &Case, h: f64, end: f64, n: usize) -> f64 {
     let model = FemModel::build(c, Some(h)).unwrap();
     let theta = integrate(&model, Scheme::CrankNicolson, end, n);
     let r = analytic(c);
-    let pts: Vec<(f64, f64)> = model.mesh.nodes.iter().map(|p| (p.x, p.y)).collect();
-    let exact = r.eval_many(&pts, end);
+    let pts = &model.mesh.nodes;
+    let exact = r.eval_many(pts, end);
     theta
         .iter()
         .zip(&exact)
@@ -844,8 +844,8 @@ fn crank_nicolson_start_damps_the_initial_jump() {
     let c = case(SQUARE);
     let model = FemModel::build(&c, Some(1.0 / 32.0)).unwrap();
     let r = analytic(&c);
-    let pts: Vec<(f64, f64)> = model.mesh.nodes.iter().map(|p| (p.x, p.y)).collect();
-    let exact = r.eval_many(&pts, 0.02);
+    let pts = &model.mesh.nodes;
+    let exact = r.eval_many(pts, 0.02);
     let err = |scheme| {
         integrate(&model, scheme, 0.02, 10)
             .iter()
@@ -1069,13 +1069,13 @@ fn sphere_converges_at_second_order() {
     for n in [40.0, 80.0, 160.0, 320.0] {
         let model = FemModel::build(&c, Some(0.1 / n)).unwrap();
         let theta = integrate(&model, Scheme::CrankNicolson, 10.0, STEPS);
-        let pts: Vec<(f64, f64)> = model.mesh.nodes.iter().map(|p| (p.x, p.y)).collect();
-        let exact = r.eval_many(&pts, 10.0);
+        let pts = &model.mesh.nodes;
+        let exact = r.eval_many(pts, 10.0);
         let (mut b, mut c0) = (0.0f64, 0.0f64);
         for ((p, t), e) in pts.iter().zip(&theta).zip(&exact) {
-            if p.0 == 0.0 {
+            if p.x == 0.0 {
                 c0 = (t - e).abs();
-            } else if p.0 >= 0.01 - 1e-12 {
+            } else if p.x >= 0.01 - 1e-12 {
                 b = b.max((t - e).abs());
             }
         }

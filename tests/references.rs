@@ -72,7 +72,7 @@ fn series_csv(n: usize, times: &[f64]) -> String {
         for j in 0..n {
             for i in 0..n {
                 let (x, y) = (i as f64 / (n - 1) as f64, j as f64 / (n - 1) as f64);
-                writeln!(s, "{x},{y},{t},{}", r.eval(x, y, t)).unwrap();
+                writeln!(s, "{x},{y},{t},{}", r.eval(x, y, 0.0, t)).unwrap();
             }
         }
     }

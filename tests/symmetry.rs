@@ -258,7 +258,7 @@ initial = 1000.0
             }
             t = to;
             let exact: Vec<f64> = (0..nb)
-                .map(|i| series.eval(model.cloud.pos[i].x, 0.0, t))
+                .map(|i| series.eval(model.cloud.pos[i].x, 0.0, 0.0, t))
                 .collect();
             let rms =
                 ((0..nb).map(|i| (theta[i] - exact[i]).powi(2)).sum::<f64>() / nb as f64).sqrt();

@@ -25,10 +25,7 @@ pub fn classical_at(
 ) -> Result<Vec<f64>> {
     let nodes = &cloud.pos[..cloud.n_body];
     match source {
-        ReferenceSource::Analytic(r) => {
-            let points: Vec<(f64, f64)> = nodes.iter().map(|p| (p.x, p.y)).collect();
-            Ok(r.eval_many(&points, t))
-        }
+        ReferenceSource::Analytic(r) => Ok(r.eval_many(nodes, t)),
         ReferenceSource::Fem(_) => Err(Error::model(
             "reference.fem",
             "the FEM reference is solved (run::resolve_reference) before it is compared",
@@ -64,7 +61,8 @@ pub fn classical_at(
 /// Compares the body temperatures `theta` with the classical ones `classical` (at the body
 /// nodes, from [`classical_at`]) at time `t`: over all nodes, along the probe line
 /// y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the body node nearest to
-/// the probe point. Nodes within `spec.exclude_tips` of a point of `tips` are left out.
+/// the probe point, and the volume-weighted relative L2 error over all nodes. Nodes within
+/// `spec.exclude_tips` of a point of `tips` are left out.
 pub fn compare(
     cloud: &Cloud,
     theta: &[f64],
@@ -94,6 +92,7 @@ pub fn compare(
     let mut max_abs: f64 = 0.0;
     let (mut sq_rel, mut n_rel) = (0.0, 0usize);
     let (mut sq, mut cmax) = (0.0, 0.0f64);
+    let (mut sq_vol, mut ref_vol) = (0.0, 0.0);
     let (mut num, mut den, mut n_line) = (0.0, 0.0, 0usize);
     let mut n_kept = 0usize;
     for i in 0..n {
@@ -109,6 +108,8 @@ pub fn compare(
             n_rel += 1;
         }
         sq += d * d;
+        sq_vol += cloud.volume[i] * d * d;
+        ref_vol += cloud.volume[i] * c * c;
         cmax = cmax.max(c.abs());
         let on_line = match line_y {
             Some(y) => (cloud.pos[i].y - y).abs() <= 0.5 * cloud.spacing[i] * (1.0 + 1e-9),
@@ -129,6 +130,11 @@ pub fn compare(
             0.0
         },
         l2_rel_line: if den > 0.0 { (num / den).sqrt() } else { 0.0 },
+        l2_rel_volume: if ref_vol > 0.0 {
+            (sq_vol / ref_vol).sqrt()
+        } else {
+            0.0
+        },
         epsilon: epsilon((sq / n_kept.max(1) as f64).sqrt(), cmax),
         line_nodes: n_line,
         probe,
@@ -321,5 +327,54 @@ mod tests {
         assert!((f.reference_max_abs - 500.0).abs() < 1e-12);
         assert!((f.epsilon() - d / 500.0).abs() < 1e-14);
         assert_eq!(epsilon(1.0, 0.0), 0.0);
+    }
+
+    /// The relative L2 error weighs each node by its volume: one node of volume 3 and three
+    /// of volume 1, all off by the same fraction f, give f; an error on the heavy node alone
+    /// counts √3 times one on a light node alone.
+    #[test]
+    fn relative_l2_is_volume_weighted() {
+        let pos: Vec<Point> = (0..4).map(|i| Point::new(i as f64, 0.0, 0.0)).collect();
+        let cloud = Cloud {
+            dim: 1,
+            tau: 1.0,
+            pos,
+            volume: vec![3.0, 1.0, 1.0, 1.0],
+            spacing: vec![1.0; 4],
+            horizon: vec![3.0; 4],
+            material: vec![0; 4],
+            region: vec![0; 4],
+            n_body: 4,
+            ..Default::default()
+        };
+        let spec = ReferenceSpec {
+            source: ReferenceSource::Analytic(Reference::AnnulusSteady {
+                inner_radius: 1.0,
+                outer_radius: 2.0,
+                inner: 0.0,
+                outer: 0.0,
+            }),
+            line_y: None,
+            line_x: None,
+            exclude_tips: 0.0,
+            probe: None,
+        };
+        let reference = vec![2.0, 5.0, -1.0, 4.0];
+        let scaled: Vec<f64> = reference.iter().map(|t| t * 1.02).collect();
+        let c = compare(&cloud, &scaled, &reference, &spec, 1.0, &[]);
+        assert!(
+            (c.l2_rel_volume - 0.02).abs() < 1e-14,
+            "{}",
+            c.l2_rel_volume
+        );
+        let norm = (3.0f64 * 4.0 + 25.0 + 1.0 + 16.0).sqrt();
+        let mut heavy = reference.clone();
+        heavy[0] += 0.1;
+        let mut light = reference.clone();
+        light[1] += 0.1;
+        let h = compare(&cloud, &heavy, &reference, &spec, 1.0, &[]).l2_rel_volume;
+        let l = compare(&cloud, &light, &reference, &spec, 1.0, &[]).l2_rel_volume;
+        assert!((h - 0.1 * 3f64.sqrt() / norm).abs() < 1e-14, "{h}");
+        assert!((l - 0.1 / norm).abs() < 1e-14, "{l}");
     }
 }

@@ -2,3 +2,4 @@
 #![allow(dead_code)]
 
 pub mod fd;
+pub mod heat_fd;

@@ -1,0 +1,5 @@
+// dim: 2
+// Mesh-convergence suite (issue 14), disc of gmsh default triangles, level 4 of 4: element
+// size h = 0.003125 m on the disc of radius 0.5 m (each level halves h). Geometry: conv_disc.inc.
+h = 0.003125;
+Include "conv_disc.inc";
