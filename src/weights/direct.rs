@@ -15,8 +15,8 @@ use rayon::prelude::*;
 
 /// Largest number of stored entries of H's lower triangle solved directly (beyond it, or in
 /// 3D where the fill of a horizon of ~100 neighbours grows too fast: CG with the two-level
-/// preconditioner). 4·10⁶ entries are ~37 000 unknowns of a 2D cloud at δ = 3Δ.
-const MAX_ENTRIES: usize = 4_000_000;
+/// preconditioner). 2.4·10⁷ entries are ~48 000 nodes of a 2D cloud at δ = 3Δ (about 2 GB of factor).
+const MAX_ENTRIES: usize = 24_000_000;
 
 /// The lower triangle of H in compressed columns, and its Cholesky factor.
 pub(super) struct Direct {
