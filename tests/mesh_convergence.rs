@@ -101,30 +101,35 @@ fn converges(family: &str, two_d: bool) {
 
 /// Rectangle of gmsh default triangles, three sides held, one free.
 #[test]
+#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
 fn rect_tri_converges() {
     converges("rect_tri", true);
 }
 
 /// The same rectangle of gmsh quadrangles (recombined triangles).
 #[test]
+#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
 fn rect_quad_converges() {
     converges("rect_quad", true);
 }
 
 /// The rectangle graded to a refined zone 4× finer (dual horizon across the transition).
 #[test]
+#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
 fn graded_converges() {
     converges("graded", true);
 }
 
 /// A disc (curved held boundary) of gmsh default triangles.
 #[test]
+#[ignore = "passes (rates 2.01, 2.00; PD/FEM 0.79 on L3) but takes minutes: issue 14 open on the suite time; run with --ignored"]
 fn disc_converges() {
     converges("disc", true);
 }
 
 /// The unit cube of gmsh default tetrahedra, all faces held.
 #[test]
+#[ignore = "issue 14 open: L1-L2 rate 1.63 measured, L3 (36 k tetrahedra) sets up in minutes; run with --ignored"]
 fn cube_tet_converges() {
     converges("cube_tet", false);
 }
