@@ -174,6 +174,14 @@ density = 1e6
 specific_heat = 1.0
 [[crack]]
 group = "crack"
+[boundary.top]
+type = "free"
+[boundary.bottom]
+type = "free"
+[boundary.left]
+type = "free"
+[boundary.right]
+type = "free"
 [initial]
 value = "100*sin(300*x) + 50*cos(200*y) + 1e4*x*y"
 [time]
