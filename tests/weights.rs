@@ -58,6 +58,7 @@ fn quadratic(p: &peritherm::math::Point, dim: usize) -> (f64, f64) {
 
 /// Largest |Σ_j K_ij (θ_j − θ_i) − V_i k ∇²θ| / (V_i k (|∇²θ| + |∇θ|/δ_i)) over the nodes the
 /// correction met, θ quadratic and evaluated at every node (fictitious ones included).
+#[allow(clippy::needless_range_loop)] // flow, positions and marks are indexed by node
 fn quadratic_error(m: &Model, dim: usize) -> (f64, usize) {
     let theta: Vec<f64> = m.cloud.pos.iter().map(|p| quadratic(p, dim).0).collect();
     let mut flow = vec![0.0; m.cloud.n_body];

@@ -34,6 +34,9 @@
 //! symmetric solution exists for a node (too few or one-sided neighbours), the node is left out
 //! and reported ([`Consistency::uncorrected`]) rather than the mesh refused.
 
+// CSR loops index several arrays (cols, vals, k0, positions) by one entry index.
+#![allow(clippy::needless_range_loop)]
+
 mod coarse;
 mod direct;
 
@@ -293,7 +296,7 @@ enum Precond<'a> {
     /// A Cholesky factor of H at earlier weights.
     Direct(&'a mut direct::Direct),
     /// Block Jacobi plus the aggregates' null modes.
-    TwoLevel(Vec<Block>, Option<coarse::Coarse>),
+    TwoLevel(Vec<Block>, Box<Option<coarse::Coarse>>),
 }
 
 impl Precond<'_> {
@@ -306,7 +309,7 @@ impl Precond<'_> {
                     .zip(r)
                     .zip(&*m)
                     .for_each(|((z, r), m)| *z = m * r);
-                if let Some(c) = coarse {
+                if let Some(c) = coarse.as_mut() {
                     c.apply(p, r, z);
                 }
             }
@@ -389,8 +392,10 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
                 direct.as_mut().expect("factored").solve(&rhs, &mut step);
             } else {
                 direct = None;
-                let mut pre =
-                    Precond::TwoLevel(p.preconditioner(vals), coarse::Coarse::new(p, vals));
+                let mut pre = Precond::TwoLevel(
+                    p.preconditioner(vals),
+                    Box::new(coarse::Coarse::new(p, vals)),
+                );
                 it = solve(p, vals, &rhs, &mut step, &mut pre, forcing);
             }
         }
