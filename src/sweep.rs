@@ -524,7 +524,7 @@ fn plot_axes(rows: &[Row]) -> Vec<(String, Axis)> {
 
 /// Convergence plots of a sweep into `out`, one per output time: the max difference (and
 /// eq 13 and the relative L2 error where there are) against each axis of `plot_axes` along
-/// which the rows differ, on log–log axes with fitted rates (seed 000 Figs 10–12, seed 003
+/// which the rows differ, on log–log axes with fitted rates (Bobaru & Duangpanya 2010 Figs 10–12, 2012
 /// Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
 pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
     let axes = plot_axes(rows);
