@@ -11,3 +11,16 @@ pub type Vector = nalgebra::Vector3<Real>;
 
 /// Index of a node in a cloud; u32 keeps neighbour lists compact.
 pub type NodeId = u32;
+
+/// Σ_{i<n} f(i) in parallel with a summation order that does not depend on the thread count
+/// (fixed chunks, partial sums added in order), so a result is the same bits on any machine.
+pub fn ordered_sum(n: usize, f: impl Fn(usize) -> Real + Sync) -> Real {
+    use rayon::prelude::*;
+    /// Terms per partial sum.
+    const CHUNK: usize = 4096;
+    let partial: Vec<Real> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum())
+        .collect();
+    partial.iter().sum()
+}

@@ -25,6 +25,8 @@ const MAX_MODES: usize = 12;
 type Modes = SVector<Real, MAX_MODES>;
 /// One block of the coarse matrix.
 type CoarseBlock = SMatrix<Real, MAX_MODES, MAX_MODES>;
+/// The null modes of one node's aggregate at the node, one column per mode.
+type NodeModes = SMatrix<Real, { super::NC }, MAX_MODES>;
 
 /// Selected nodes per aggregate, by dimension.
 fn aggregate_size(dim: usize) -> usize {
@@ -45,6 +47,8 @@ struct Aggregates {
     centre: Vec<(Point, Real)>,
     /// Modes per aggregate.
     m: usize,
+    /// The modes at each body node (zero at unselected nodes), computed once.
+    z: Vec<NodeModes>,
 }
 
 /// Aggregates and the factorised coarse matrix.
@@ -100,13 +104,8 @@ impl Aggregates {
     }
 
     /// u_i = (φ·mode_k(i))_k for the scaled moment vector `ph` of node i.
-    fn project(&self, p: &Problem, i: usize, ph: &Mom) -> Modes {
-        let a = self.agg[i] as usize;
-        let mut u = Modes::zeros();
-        for k in 0..self.m {
-            u[k] = ph.dot(&self.mode(p, a, i, k));
-        }
-        u
+    fn project(&self, i: usize, ph: &Mom) -> Modes {
+        self.z[i].tr_mul(ph)
     }
 
     /// Cuts the selected nodes of `p` into aggregates.
@@ -136,12 +135,26 @@ impl Aggregates {
                 (Point::from(c / n), s / n)
             })
             .collect();
-        Some(Aggregates {
+        let mut aggs = Aggregates {
             agg,
             members,
             centre,
             m: dim + dim * dim,
-        })
+            z: Vec::new(),
+        };
+        aggs.z = (0..p.n())
+            .into_par_iter()
+            .map(|i| {
+                let mut z = NodeModes::zeros();
+                if let Some(a) = (aggs.agg[i] != u32::MAX).then_some(aggs.agg[i] as usize) {
+                    for k in 0..aggs.m {
+                        z.set_column(k, &aggs.mode(p, a, i, k));
+                    }
+                }
+                z
+            })
+            .collect();
+        Some(aggs)
     }
 
     /// The lower triangle of E = Σ_pairs K' (u_i + u_j)(u_i + u_j)ᵀ for the weights `vals`.
@@ -181,11 +194,12 @@ impl Aggregates {
             for e in p.offsets[i]..p.offsets[i + 1] {
                 let j = p.cols[e] as usize;
                 let (pi, pj) = p.phis(i, j);
-                let ui = self.project(p, i, &pi) * vals[e];
-                out[0].1 += ui * self.project(p, i, &pi).transpose();
+                let pu = self.project(i, &pi);
+                out[0].1 += (pu * vals[e]) * pu.transpose();
+                let ui = pu * vals[e];
                 if j < p.n() && p.sel[j] {
                     let b = self.agg[j] as usize;
-                    let uj = self.project(p, j, &pj);
+                    let uj = self.project(j, &pj);
                     let slot = match out.iter().position(|(x, _)| *x == b) {
                         Some(s) => s,
                         None => {
@@ -201,17 +215,14 @@ impl Aggregates {
     }
 
     /// Zᵀ r, aggregate by aggregate.
-    fn restrict(&self, p: &Problem, r: &[Mom]) -> Vec<Real> {
+    fn restrict(&self, r: &[Mom]) -> Vec<Real> {
         let m = self.m;
         self.members
             .par_iter()
-            .enumerate()
-            .flat_map_iter(|(a, list)| {
+            .flat_map_iter(|list| {
                 let mut s = Modes::zeros();
                 for &i in list {
-                    for k in 0..m {
-                        s[k] += self.mode(p, a, i as usize, k).dot(&r[i as usize]);
-                    }
+                    s += self.project(i as usize, &r[i as usize]);
                 }
                 (0..m).map(move |k| s[k])
             })
@@ -219,7 +230,7 @@ impl Aggregates {
     }
 
     /// z += Z c.
-    fn prolong(&self, p: &Problem, c: &[Real], z: &mut [Mom]) {
+    fn prolong(&self, c: &[Real], z: &mut [Mom]) {
         let m = self.m;
         z.par_iter_mut().enumerate().for_each(|(i, zi)| {
             let a = self.agg[i];
@@ -227,9 +238,8 @@ impl Aggregates {
                 return;
             }
             let a = a as usize;
-            for k in 0..m {
-                *zi += c[a * m + k] * self.mode(p, a, i, k);
-            }
+            let ca = Modes::from_fn(|k, _| if k < m { c[a * m + k] } else { 0.0 });
+            *zi += self.z[i] * ca;
         });
     }
 }
@@ -271,8 +281,8 @@ impl Coarse {
     }
 
     /// z += Z E⁻¹ Zᵀ r.
-    pub(super) fn apply(&mut self, p: &Problem, r: &[Mom], z: &mut [Mom]) {
-        let mut c = self.aggs.restrict(p, r);
+    pub(super) fn apply(&mut self, r: &[Mom], z: &mut [Mom]) {
+        let mut c = self.aggs.restrict(r);
         let n = c.len();
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
@@ -280,7 +290,7 @@ impl Coarse {
             faer::get_global_parallelism(),
             MemStack::new(&mut self.scratch),
         );
-        self.aggs.prolong(p, &c, z);
+        self.aggs.prolong(&c, z);
     }
 }
 

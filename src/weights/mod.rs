@@ -25,6 +25,12 @@
 //! moment residual; we minimise it by Newton's method with a backtracking line search, each
 //! Newton system solved by block-Jacobi conjugate gradients.
 //!
+//! Two short cuts: a cloud already consistent to [`TOLERANCE`] (a lattice without a horizon
+//! change) keeps K bit for bit, and the linear order first tries the additive form of one
+//! linear solve ([`additive`]), exact in one step, falling back to the entropy form only where
+//! that would make a pair non-positive. The Newton iterations, the parallel sums and hence the
+//! weights are the same bits at any thread count.
+//!
 //! The anchors in the literature: Seleson 2014 (improved one-point quadrature for peridynamics)
 //! and Pasetto, Shen, D'Elia, Tian, Trask & Kamensky 2022 (optimization-based quadrature) fit
 //! quadrature weights to integrate polynomials; Trask, You, Yu & Parks 2019 (an asymptotically
@@ -37,6 +43,7 @@
 // CSR loops index several arrays (cols, vals, k0, positions) by one entry index.
 #![allow(clippy::needless_range_loop)]
 
+mod additive;
 mod coarse;
 mod direct;
 
@@ -182,22 +189,19 @@ impl Problem<'_> {
     /// The dual objective D(λ) = Σ_pairs K'_ij − Σ_i λ_i·t_i for the weights `vals`.
     fn dual(&self, lambda: &[Mom], vals: &[Real]) -> Real {
         let n = self.n();
-        (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let mut s = 0.0;
-                for e in self.offsets[i]..self.offsets[i + 1] {
-                    // pairs of two body nodes appear in both rows
-                    let half = if (self.cols[e] as usize) < n {
-                        0.5
-                    } else {
-                        1.0
-                    };
-                    s += half * vals[e];
-                }
-                s - self.lam(lambda, i).map_or(0.0, |l| l.dot(&self.target[i]))
-            })
-            .sum()
+        crate::math::ordered_sum(n, |i| {
+            let mut s = 0.0;
+            for e in self.offsets[i]..self.offsets[i + 1] {
+                // pairs of two body nodes appear in both rows
+                let half = if (self.cols[e] as usize) < n {
+                    0.5
+                } else {
+                    1.0
+                };
+                s += half * vals[e];
+            }
+            s - self.lam(lambda, i).map_or(0.0, |l| l.dot(&self.target[i]))
+        })
     }
 
     /// Moment residual r_i = Σ_j K'_ij φ_i(ξ_ij) − t_i at the selected nodes (0 elsewhere).
@@ -287,7 +291,7 @@ impl Problem<'_> {
 }
 
 fn dot(a: &[Mom], b: &[Mom]) -> Real {
-    a.par_iter().zip(b).map(|(x, y)| x.dot(y)).sum()
+    crate::math::ordered_sum(a.len(), |i| a[i].dot(&b[i]))
 }
 
 /// Solves H x = b by block-Jacobi preconditioned CG to `rel` of |b|; returns the iterations.
@@ -301,7 +305,7 @@ enum Precond<'a> {
 
 impl Precond<'_> {
     /// z = M⁻¹ r.
-    fn apply(&mut self, p: &Problem, r: &[Mom], z: &mut [Mom]) {
+    fn apply(&mut self, r: &[Mom], z: &mut [Mom]) {
         match self {
             Precond::Direct(d) => d.solve(r, z),
             Precond::TwoLevel(m, coarse) => {
@@ -310,7 +314,7 @@ impl Precond<'_> {
                     .zip(&*m)
                     .for_each(|((z, r), m)| *z = m * r);
                 if let Some(c) = coarse.as_mut() {
-                    c.apply(p, r, z);
+                    c.apply(r, z);
                 }
             }
         }
@@ -327,7 +331,7 @@ fn solve(
     rel: Real,
 ) -> usize {
     let cap = 20_000;
-    let precondition = |r: &[Mom], z: &mut Vec<Mom>, pre: &mut Precond| pre.apply(p, r, z);
+    let precondition = |r: &[Mom], z: &mut Vec<Mom>, pre: &mut Precond| pre.apply(r, z);
     x.iter_mut().for_each(|v| *v = Mom::zeros());
     let norm_b = dot(b, b).sqrt();
     if norm_b == 0.0 {
@@ -361,6 +365,22 @@ fn solve(
     it
 }
 
+/// Newton iterations over which the worst residual must halve once it is below
+/// [`STALL_LEVEL`], or the round ends (a node without a positive solution drives its λ to
+/// infinity and the residual stalls, where Newton otherwise converges quadratically).
+const STALL_WINDOW: usize = 8;
+/// Worst relative residual below which Newton is in its fast phase (far from the solution
+/// the residual may grow for a few damped steps).
+const STALL_LEVEL: Real = 1e-3;
+
+/// Whether the last [`STALL_WINDOW`] Newton iterations failed to halve the worst residual.
+fn stalled(history: &[Real]) -> bool {
+    let n = history.len();
+    n > STALL_WINDOW
+        && history[n - 1] < STALL_LEVEL
+        && history[n - 1] > 0.5 * history[n - 1 - STALL_WINDOW]
+}
+
 /// One round of Newton's method on the dual from `lambda`; returns (Newton, CG) iterations.
 fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) {
     let n = p.n();
@@ -371,10 +391,12 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
     let mut direct = direct::Direct::new(p);
     p.weights(lambda, vals);
     let mut d0 = p.dual(lambda, vals);
+    let mut history = Vec::with_capacity(MAX_NEWTON);
     for _ in 0..MAX_NEWTON {
         let res = p.residual(vals);
         let worst = p.worst(&res);
-        if worst <= TOLERANCE {
+        history.push(worst);
+        if worst <= TOLERANCE || stalled(&history) {
             break;
         }
         let rhs: Vec<Mom> = res.iter().map(|r| -r).collect();
@@ -411,7 +433,10 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
             }
             p.weights(&trial, &mut trial_vals);
             let d1 = p.dual(&trial, &trial_vals);
-            if d1.is_finite() && d1 <= d0 + 1e-4 * alpha * slope {
+            // near the optimum the decrease of D is below its round-off: a step that halves
+            // the worst moment residual is then taken on that evidence
+            let armijo = d1.is_finite() && d1 <= d0 + 1e-4 * alpha * slope;
+            if armijo || (d1.is_finite() && p.worst(&p.residual(&trial_vals)) < 0.5 * worst) {
                 lambda.copy_from_slice(&trial);
                 vals.copy_from_slice(&trial_vals);
                 d0 = d1;
@@ -503,6 +528,23 @@ pub fn correct(
         max_ratio: 1.0,
         ..Default::default()
     };
+    if out.before <= TOLERANCE {
+        // already consistent (a lattice without a horizon change): K stays as it is, bit for bit
+        let vals = p.k0.clone();
+        summarise(&p, &vals, &[], &mut out);
+        return (out, p.sel);
+    }
+    if order == Order::Linear {
+        if let Some((vals, it)) = additive::linear(&p) {
+            if p.worst(&p.residual(&vals)) <= TOLERANCE {
+                out.iterations = it;
+                summarise(&p, &vals, &[], &mut out);
+                let sel = p.sel;
+                store(k, vals);
+                return (out, sel);
+            }
+        }
+    }
     let mut lambda = vec![Mom::zeros(); n];
     let mut vals = p.k0.clone();
     let mut left_out = vec![false; n];
@@ -533,11 +575,17 @@ pub fn correct(
         lambda.iter_mut().for_each(|l| *l = Mom::zeros());
     }
     summarise(&p, &vals, &left_out, &mut out);
+    let sel = p.sel;
+    store(k, vals);
+    (out, sel)
+}
+
+/// Stores the pair conductances `vals` in `k` with their row sums.
+fn store(k: &mut Conductance, vals: Vec<Real>) {
     k.vals = vals;
-    for i in 0..n {
+    for i in 0..k.n_rows() {
         k.diag[i] = k.vals[k.offsets[i]..k.offsets[i + 1]].iter().sum();
     }
-    (out, p.sel)
 }
 
 /// Fills the counts, errors and ratios of `out` from the final weights.
