@@ -101,28 +101,27 @@ fn converges(family: &str, two_d: bool) {
 
 /// Rectangle of gmsh default triangles, three sides held, one free.
 #[test]
-#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
+#[ignore = "passes (docs/mesh-convergence.md) but takes minutes on 2 cores; run with --ignored"]
 fn rect_tri_converges() {
     converges("rect_tri", true);
 }
 
 /// The same rectangle of gmsh quadrangles (recombined triangles).
 #[test]
-#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
+#[ignore = "passes (docs/mesh-convergence.md) but takes minutes on 2 cores; run with --ignored"]
 fn rect_quad_converges() {
     converges("rect_quad", true);
 }
 
 /// The rectangle graded to a refined zone 4× finer (dual horizon across the transition).
 #[test]
-#[ignore = "issue 14 open: not yet measured with the consistent weights (levels 1-3 take minutes); run with --ignored"]
 fn graded_converges() {
     converges("graded", true);
 }
 
 /// A disc (curved held boundary) of gmsh default triangles.
 #[test]
-#[ignore = "passes (rates 2.01, 2.00; PD/FEM 0.79 on L3) but takes minutes: issue 14 open on the suite time; run with --ignored"]
+#[ignore = "passes (docs/mesh-convergence.md) but takes minutes on 2 cores; run with --ignored"]
 fn disc_converges() {
     converges("disc", true);
 }
