@@ -325,6 +325,41 @@ impl Reference {
 
     /// The parameters a series cannot be evaluated with, as a message (`None`: usable).
     pub fn check(&self) -> Option<String> {
+        // every parameter finite (non-finite numbers serialise as null), every length,
+        // diffusivity and material constant a normal positive number
+        let value = serde_json::to_value(self).unwrap_or_default();
+        for (name, v) in value.as_object().into_iter().flatten() {
+            let numbers: Vec<Option<f64>> = match v {
+                serde_json::Value::Array(a) if a.iter().any(|x| x.is_string()) => continue,
+                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+                serde_json::Value::String(_) => continue,
+                x => vec![x.as_f64()],
+            };
+            if numbers.iter().any(|x| x.is_none_or(|x| !x.is_finite())) {
+                return Some(format!("{name} must be finite, got {v}"));
+            }
+            let must_be_positive = ["length", "diffusivity", "radius", "density", "latent_heat"]
+                .iter()
+                .any(|k| name.contains(k))
+                || name.ends_with("conductivity")
+                || name.ends_with("specific_heat")
+                || name == "size";
+            if must_be_positive && numbers.iter().flatten().any(|x| !(x.is_normal() && *x > 0.0)) {
+                return Some(format!("{name} must be a positive number, got {v}"));
+            }
+        }
+        if let Reference::AnnulusSteady {
+            inner_radius,
+            outer_radius,
+            ..
+        } = self
+        {
+            if outer_radius <= inner_radius {
+                return Some(format!(
+                    "outer_radius {outer_radius} must exceed inner_radius {inner_radius}"
+                ));
+            }
+        }
         match self {
             Reference::BoxFixedFaces {
                 min,
