@@ -592,7 +592,11 @@ fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
         Err(case_err(
             path,
             key,
-            format!("must be a positive number, got {v}"),
+            if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+                format!("must be a positive number, got {v:e}")
+            } else {
+                format!("must be a positive number, got {v}")
+            },
         ))
     }
 }

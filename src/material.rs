@@ -188,6 +188,12 @@ impl Material {
             ]);
         }
         if let Some((key, v, _, what)) = checks.into_iter().find(|c| !c.2) {
+            // tiny and huge values in exponent form (a subnormal's digits fill a screen)
+            let v = if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+                format!("{v:e}")
+            } else {
+                format!("{v}")
+            };
             return Err((key.to_string(), format!("must be {what}, got {v}")));
         }
         // each factor may be normal while ρc or k/(ρc) is not
