@@ -159,6 +159,12 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
                 r.0 += 1.0;
                 r.2 += ball(dim, m + 1.0);
             }
+            if let Some(r) = out.iter().position(|c| c.0 == 0.0) {
+                return Err(crate::Error::model(
+                    format!("region[{r}].name"),
+                    "the mesh's group of this region has no elements",
+                ));
+            }
             // mirrored layers: about one node per boundary facet and spacing of reach
             if layered.iter().any(|&l| l) {
                 if let Some(r) = out.first_mut() {

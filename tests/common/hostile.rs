@@ -25,10 +25,14 @@ value = 100.0
 end = 2.0
 "#;
 
-/// Limits of every refusal (issue 15's "done when"): wall time and address space.
+/// Limits of every refusal (issue 15's "done when"): wall time and resident memory.
 pub const MAX_SECONDS: f64 = 5.0;
-/// Address-space limit of the CLI under test, KiB (1 GiB).
+/// Resident-memory limit of a refusal, KiB (1 GiB), measured by `/usr/bin/time`.
 pub const MAX_KIB: u64 = 1 << 20;
+/// Address-space limit of the CLI under test, KiB (8 GiB): a safety net that makes a run
+/// trying to fill the machine fail; it is above 1 GiB because the dense kernels reserve
+/// (without touching) large per-thread workspaces.
+pub const ADDRESS_KIB: u64 = 8 << 20;
 
 /// The outcome of one CLI call.
 pub struct Outcome {
@@ -40,24 +44,41 @@ pub struct Outcome {
     pub stderr: String,
     /// Wall time, s.
     pub seconds: f64,
+    /// Peak resident memory, KiB (0 where `/usr/bin/time` is missing).
+    pub max_kib: u64,
 }
 
-/// Runs the `peritherm` binary with `args` under a 1 GiB address-space limit (`ulimit -v`):
-/// a run that tried to fill the machine fails instead.
+/// Runs the `peritherm` binary with `args` under [`ADDRESS_KIB`] of address space
+/// (`ulimit -v`), measuring its peak resident memory with `/usr/bin/time` when present.
 pub fn peritherm(args: &[&str]) -> Outcome {
     let started = Instant::now();
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {MAX_KIB}; exec \"$0\" \"$@\""))
+    let report = tempfile::NamedTempFile::new().unwrap();
+    let timed = Path::new("/usr/bin/time").exists();
+    let mut cmd = Command::new("sh");
+    cmd.arg("-c");
+    if timed {
+        cmd.arg(format!(
+            "ulimit -v {ADDRESS_KIB}; exec /usr/bin/time -q -o \"{}\" -f %M \"$0\" \"$@\"",
+            report.path().display()
+        ));
+    } else {
+        cmd.arg(format!("ulimit -v {ADDRESS_KIB}; exec \"$0\" \"$@\""));
+    }
+    let o = cmd
         .arg(env!("CARGO_BIN_EXE_peritherm"))
         .args(args)
         .output()
         .unwrap();
+    let max_kib = std::fs::read_to_string(report.path())
+        .ok()
+        .and_then(|s| s.lines().last().and_then(|l| l.trim().parse().ok()))
+        .unwrap_or(0);
     Outcome {
         code: o.status.code(),
         stdout: String::from_utf8_lossy(&o.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
         seconds: started.elapsed().as_secs_f64(),
+        max_kib,
     }
 }
 
@@ -81,6 +102,11 @@ pub fn assert_refused(what: &str, o: &Outcome, file: &str, key: &str) {
         o.seconds < MAX_SECONDS,
         "{what}: took {:.1} s: {err}",
         o.seconds
+    );
+    assert!(
+        o.max_kib < MAX_KIB,
+        "{what}: used {} KiB: {err}",
+        o.max_kib
     );
 }
 
@@ -171,7 +197,21 @@ pub fn mutate(text: &str, rng: &mut Rng) -> String {
         return String::new();
     }
     let mut out: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
-    match rng.below(8) {
+    match rng.below(10) {
+        8 | 9 => {
+            // a benign change: a number scaled by 2, 1/2 or 3/2 (often still a valid case)
+            let k = rng.below(out.len());
+            let factor = *rng.pick(&[2.0, 0.5, 1.5]);
+            let scaled: Vec<String> = out[k]
+                .split(' ')
+                .map(|w| match w.trim_end_matches(',').parse::<f64>() {
+                    Ok(v) if w.ends_with(',') => format!("{},", v * factor),
+                    Ok(v) => format!("{}", v * factor),
+                    Err(_) => w.to_string(),
+                })
+                .collect();
+            out[k] = scaled.join(" ");
+        }
         0..=2 => {
             // a value after `=` (case) or a number on a line (mesh) replaced
             let k = rng.below(out.len());
@@ -211,6 +251,7 @@ pub fn mutate(text: &str, rng: &mut Rng) -> String {
             return joined[..cut].to_string();
         }
         _ => {
+            // 7: bytes flipped
             let mut bytes = out.join("\n").into_bytes();
             for _ in 0..1 + rng.below(4) {
                 let k = rng.below(bytes.len().max(1));
