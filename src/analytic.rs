@@ -345,7 +345,7 @@ impl Reference {
                 || name.ends_with("specific_heat")
                 || name == "size";
             if must_be_positive && numbers.iter().flatten().any(|x| !(x.is_normal() && *x > 0.0)) {
-                return Some(format!("{name} must be a positive number, got {v}"));
+                return Some(format!("{name} must be > 0, got {v}"));
             }
         }
         if let Reference::AnnulusSteady {
@@ -880,6 +880,32 @@ mod tests {
         let text = "kind = \"box_fixed_faces\"\nmin = [0.0]\nsize = [1.0]\nends = [\"fixed_low\"]\ndiffusivity = 1.0\nedge = 0.0\ninitial = 1.0\n";
         let r: Reference = toml::from_str(text).unwrap();
         assert_eq!(r.check(), None);
+    }
+
+    /// Issue 15: every series' lengths and diffusivities are validated, and every parameter
+    /// must be finite (a length of 0 gave NaN, a diffusivity of −1 gave 3.5e169).
+    #[test]
+    fn every_series_parameter_is_validated() {
+        let bar = |length: f64, diffusivity: f64, initial: f64| Reference::BarFixedEnds {
+            x0: 0.0,
+            length,
+            diffusivity,
+            left: 0.0,
+            right: 0.0,
+            initial,
+        };
+        assert_eq!(bar(1.0, 1.0, 1.0).check(), None);
+        assert!(bar(0.0, 1.0, 1.0).check().unwrap().contains("length"));
+        assert!(bar(1.0, -1.0, 1.0).check().unwrap().contains("diffusivity"));
+        assert!(bar(1.0, 1e-320, 1.0).check().unwrap().contains("diffusivity"));
+        assert!(bar(1.0, 1.0, f64::NAN).check().unwrap().contains("initial"));
+        let annulus = Reference::AnnulusSteady {
+            inner_radius: 2.0,
+            outer_radius: 1.0,
+            inner: 0.0,
+            outer: 1.0,
+        };
+        assert!(annulus.check().unwrap().contains("outer_radius"));
     }
 
     fn water_freezing() -> Reference {
