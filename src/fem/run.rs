@@ -289,7 +289,11 @@ pub fn run_fem(
             Ok(summary)
         }
         Err(e) => {
-            staged.fail(&name, &e.to_string())?;
+            // a refusal before anything was written leaves `out` as it was
+            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
+            if wrote {
+                staged.fail(&name, &e.to_string())?;
+            }
             Err(e)
         }
     }
