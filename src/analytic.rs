@@ -344,7 +344,12 @@ impl Reference {
                 || name.ends_with("conductivity")
                 || name.ends_with("specific_heat")
                 || name == "size";
-            if must_be_positive && numbers.iter().flatten().any(|x| !(x.is_normal() && *x > 0.0)) {
+            if must_be_positive
+                && numbers
+                    .iter()
+                    .flatten()
+                    .any(|x| !(x.is_normal() && *x > 0.0))
+            {
                 return Some(format!("{name} must be > 0, got {v}"));
             }
         }
@@ -897,7 +902,10 @@ mod tests {
         assert_eq!(bar(1.0, 1.0, 1.0).check(), None);
         assert!(bar(0.0, 1.0, 1.0).check().unwrap().contains("length"));
         assert!(bar(1.0, -1.0, 1.0).check().unwrap().contains("diffusivity"));
-        assert!(bar(1.0, 1e-320, 1.0).check().unwrap().contains("diffusivity"));
+        assert!(bar(1.0, 1e-320, 1.0)
+            .check()
+            .unwrap()
+            .contains("diffusivity"));
         assert!(bar(1.0, 1.0, f64::NAN).check().unwrap().contains("initial"));
         let annulus = Reference::AnnulusSteady {
             inner_radius: 2.0,

@@ -43,7 +43,13 @@ impl Memory {
         let field = |name: &str| {
             text.lines()
                 .find_map(|l| l.strip_prefix(name))
-                .and_then(|rest| rest.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+                .and_then(|rest| {
+                    rest.trim()
+                        .trim_end_matches("kB")
+                        .trim()
+                        .parse::<f64>()
+                        .ok()
+                })
                 .map(|kb| kb * 1024.0)
         };
         Memory {
@@ -272,7 +278,10 @@ impl Estimate {
             self.fictitious,
             self.bonds,
             human(self.bytes),
-            machine.available.map(human).unwrap_or_else(|| "unknown".into())
+            machine
+                .available
+                .map(human)
+                .unwrap_or_else(|| "unknown".into())
         )
     }
 }
@@ -283,7 +292,10 @@ pub fn fem_box(size: &[f64], h: f64) -> (f64, f64) {
     let dim = size.len();
     let nodes: f64 = size.iter().map(|l| (l / h).ceil() + 1.0).product();
     let entries = nodes * 3f64.powi(dim as i32);
-    (nodes, nodes * BYTES_PER_NODE + entries * FEM_BYTES_PER_ENTRY)
+    (
+        nodes,
+        nodes * BYTES_PER_NODE + entries * FEM_BYTES_PER_ENTRY,
+    )
 }
 
 #[cfg(test)]

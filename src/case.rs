@@ -627,6 +627,47 @@ pub(crate) fn horizon_key(r: usize, reg: &RegionSpec) -> String {
     }
 }
 
+/// The points of `crack[c]`: coordinates of the dimension, no segment of zero length, and a
+/// path that enters the body's interior.
+fn crack_points(
+    path: &Path,
+    c: usize,
+    dim: usize,
+    pts: &[Vec<f64>],
+    geometry: &Geometry,
+) -> Result<Vec<Point>> {
+    let key = |k: &str| format!("crack[{c}].{k}");
+    let mut list: Vec<Point> = Vec::new();
+    for (k, p) in pts.iter().enumerate() {
+        let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
+        let q = Point::new(q[0], q[1], q[2]);
+        if list
+            .last()
+            .is_some_and(|l| (q - l).norm() <= 1e-12 * q.coords.amax())
+        {
+            return Err(case_err(
+                path,
+                &key(&format!("points[{k}]")),
+                "repeats the previous point: a crack segment of zero length",
+            ));
+        }
+        list.push(q);
+    }
+    let (lo, hi) = geometry_bounds(geometry, dim);
+    if !crosses_interior(&list, dim, lo, hi) {
+        return Err(case_err(
+            path,
+            &key("points"),
+            format!(
+                "the crack does not pass through the body's interior ({:?} to {:?} m): it lies outside it or along its boundary",
+                &lo[..dim],
+                &hi[..dim]
+            ),
+        ));
+    }
+    Ok(list)
+}
+
 /// The body's bounding box, m: a box's domain, a mesh's nodes (scaled).
 fn geometry_bounds(geometry: &Geometry, dim: usize) -> ([f64; 3], [f64; 3]) {
     match geometry {
@@ -653,7 +694,9 @@ fn crosses_interior(pts: &[Point], dim: usize, lo: [f64; 3], hi: [f64; 3]) -> bo
         return (0..3).all(|a| {
             let (pmin, pmax) = pts
                 .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[a]), h.max(p[a])));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                    (l.min(p[a]), h.max(p[a]))
+                });
             pmin < hi[a] - eps[a] && pmax > lo[a] + eps[a]
         });
     }
@@ -686,6 +729,19 @@ fn in_case(path: &Path, e: Error) -> Error {
 }
 
 impl CaseFile {
+    /// The key that sets each region's node count, for the budget's message.
+    fn size_keys(&self) -> Vec<String> {
+        self.region
+            .iter()
+            .enumerate()
+            .map(|(r, reg)| match (&self.mesh, &reg.cells) {
+                (Some(_), _) => "mesh.file".to_string(),
+                (None, Some(_)) => format!("region[{r}].cells"),
+                (None, None) => format!("region[{r}].spacing"),
+            })
+            .collect()
+    }
+
     /// The built-in box geometry of `[domain]` and the `[[region]]` boxes.
     fn box_geometry(
         &self,
@@ -932,31 +988,7 @@ impl CaseFile {
                             format!("needs at least {need} points"),
                         ));
                     }
-                    let mut list: Vec<Point> = Vec::new();
-                    for (k, p) in pts.iter().enumerate() {
-                        let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
-                        let q = Point::new(q[0], q[1], q[2]);
-                        if list.last().is_some_and(|l| (q - l).norm() <= 1e-12 * q.coords.amax()) {
-                            return Err(case_err(
-                                path,
-                                &key(&format!("points[{k}]")),
-                                "repeats the previous point: a crack segment of zero length",
-                            ));
-                        }
-                        list.push(q);
-                    }
-                    let (lo, hi) = geometry_bounds(geometry, dim);
-                    if !crosses_interior(&list, dim, lo, hi) {
-                        return Err(case_err(
-                            path,
-                            &key("points"),
-                            format!(
-                                "the crack does not pass through the body's interior ({:?} to {:?} m): it lies outside it or along its boundary",
-                                &lo[..dim],
-                                &hi[..dim]
-                            ),
-                        ));
-                    }
+                    let list = crack_points(path, c, dim, pts, geometry)?;
                     if dim == 2 {
                         CrackShape::Polyline(list)
                     } else {
@@ -1457,30 +1489,21 @@ impl CaseFile {
             }
         }
         let spec = ModelSpec {
-                geometry,
-                materials,
-                kernel,
-                bond_rule: self.kernel.bond_rule,
-                faces,
-                cracks,
-                source,
-                initial,
-                consistency: self
-                    .kernel
-                    .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
-                crack_correction: self.kernel.crack_correction,
-                symmetry: self.symmetry,
+            geometry,
+            materials,
+            kernel,
+            bond_rule: self.kernel.bond_rule,
+            faces,
+            cracks,
+            source,
+            initial,
+            consistency: self
+                .kernel
+                .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
+            crack_correction: self.kernel.crack_correction,
+            symmetry: self.symmetry,
         };
-        let size_keys: Vec<String> = self
-            .region
-            .iter()
-            .enumerate()
-            .map(|(r, reg)| match (&self.mesh, &reg.cells) {
-                (Some(_), _) => "mesh.file".to_string(),
-                (None, Some(_)) => format!("region[{r}].cells"),
-                (None, None) => format!("region[{r}].spacing"),
-            })
-            .collect();
+        let size_keys = self.size_keys();
         let budget = crate::budget::estimate(&spec, &size_keys, integrator.is_implicit())
             .map_err(|e| in_case(path, e))?;
         Ok(Case {

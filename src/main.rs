@@ -497,7 +497,9 @@ fn same_body(
                 b.1.display()
             );
         }
-        if (alo[k] - blo[k]).abs() > tol + 0.05 * extent || (ahi[k] - bhi[k]).abs() > tol + 0.05 * extent {
+        if (alo[k] - blo[k]).abs() > tol + 0.05 * extent
+            || (ahi[k] - bhi[k]).abs() > tol + 0.05 * extent
+        {
             anyhow::bail!(
                 "{} and {}: the runs' bodies differ along axis {k} ({:e}..{:e} m against {:e}..{:e} m); compare runs of the same body",
                 a.1.display(),

@@ -218,7 +218,9 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
     })?;
     // every line of a complete file ends with a newline: a file cut mid-number does not
     if !text.ends_with('\n') {
-        return Err(bad("does not end with a newline: the file is cut short".into()));
+        return Err(bad(
+            "does not end with a newline: the file is cut short".into()
+        ));
     }
     let mut lines = text.lines();
     let header = lines.next().unwrap_or("");
@@ -392,8 +394,12 @@ impl RunSummary {
             path: path.clone(),
             error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
         };
-        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
-        let status = value.get("status").and_then(|s| s.as_str()).map(str::to_string);
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        let status = value
+            .get("status")
+            .and_then(|s| s.as_str())
+            .map(str::to_string);
         if let Some(status) = status {
             if status != "complete" {
                 let u: crate::staging::Unfinished =

@@ -91,42 +91,58 @@ fn execute(
     let started = Instant::now();
     let reference = resolve_reference(case, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
-    let mut on_output =
-        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
-            energy.push(e);
-            let path = field_path(out, k + 1);
-            let flux = conductance.flux(&model.cloud, th);
-            let damage = model.damage_at(t);
-            let classical = match &reference {
-                Some(r) => {
-                    let started = Instant::now();
-                    let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                    let tips = tips_at(&cutters, t);
-                    comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
-                    reference_seconds += started.elapsed().as_secs_f64();
-                    Some(classical)
+    let mut on_output = |k: usize,
+                         t: f64,
+                         th: &[f64],
+                         conductance: &crate::operator::Conductance,
+                         e: f64| {
+        energy.push(e);
+        let path = field_path(out, k + 1);
+        let flux = conductance.flux(&model.cloud, th);
+        let damage = model.damage_at(t);
+        let classical = match &reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                let tips = tips_at(&cutters, t);
+                let c = compare(&model.cloud, th, &classical, r, t, &tips);
+                let measures = [c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line, c.epsilon];
+                if measures.iter().any(|v| !v.is_finite()) {
+                    // finite values whose squares overflow: never an exact match
+                    return Err(Error::Case {
+                            file: case.path.clone(),
+                            key: "reference".into(),
+                            message: format!(
+                                "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
+                                c.max_abs_diff
+                            ),
+                        });
                 }
-                None => None,
-            };
-            let f = Fields {
-                theta: th,
-                damage: &damage,
-                flux: &flux,
-                reference: classical.as_deref(),
-            };
-            write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-            write_atomic(
-                &vtu_path(out, k + 1),
-                field_vtu(&model.cloud, &f).as_bytes(),
-            )?;
-            fields.push(
-                path.file_name()
-                    .expect("file")
-                    .to_string_lossy()
-                    .into_owned(),
-            );
-            Ok(())
+                comparisons.push(c);
+                reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
         };
+        let f = Fields {
+            theta: th,
+            damage: &damage,
+            flux: &flux,
+            reference: classical.as_deref(),
+        };
+        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic(
+            &vtu_path(out, k + 1),
+            field_vtu(&model.cloud, &f).as_bytes(),
+        )?;
+        fields.push(
+            path.file_name()
+                .expect("file")
+                .to_string_lossy()
+                .into_owned(),
+        );
+        Ok(())
+    };
     let linear_output = |k: usize, t: f64, th: &[f64], c: &crate::operator::Conductance| {
         on_output(k, t, th, c, model.energy(th))
     };

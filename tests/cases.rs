@@ -20,8 +20,8 @@ fn every_case_builds_and_starts() {
     for path in names {
         let started = std::time::Instant::now();
         let mut case = Case::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let model = peritherm::prepare::build(&case, &Default::default())
-            .unwrap_or_else(|e| panic!("{e}"));
+        let model =
+            peritherm::prepare::build(&case, &Default::default()).unwrap_or_else(|e| panic!("{e}"));
         let bound = case.integrator.stable_dt(&model);
         if let Some(dt) = case.dt {
             assert!(

@@ -162,7 +162,10 @@ fn mutated_cases_and_meshes_end_ok_or_with_one_clear_error() {
         }
     }
     let seconds = started.elapsed().as_secs_f64();
-    eprintln!("fuzz: {inputs} inputs in {seconds:.1} s: {ok} ok, {refused} refused, {} failed", failures.len());
+    eprintln!(
+        "fuzz: {inputs} inputs in {seconds:.1} s: {ok} ok, {refused} refused, {} failed",
+        failures.len()
+    );
     assert!(
         failures.is_empty(),
         "{} of {inputs} inputs failed; the first:\n{}",

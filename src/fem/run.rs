@@ -333,7 +333,11 @@ fn budget(case: &Case, opts: &FemOptions, dt: f64) -> Result<()> {
     };
     estimate.enforce(None).map_err(|m| {
         Error::model(
-            if opts.h.is_some() { "--h" } else { "region.spacing" },
+            if opts.h.is_some() {
+                "--h"
+            } else {
+                "region.spacing"
+            },
             format!("fem: h = {h:e} m {m}"),
         )
     })

@@ -103,11 +103,7 @@ pub fn assert_refused(what: &str, o: &Outcome, file: &str, key: &str) {
         "{what}: took {:.1} s: {err}",
         o.seconds
     );
-    assert!(
-        o.max_kib < MAX_KIB,
-        "{what}: used {} KiB: {err}",
-        o.max_kib
-    );
+    assert!(o.max_kib < MAX_KIB, "{what}: used {} KiB: {err}", o.max_kib);
 }
 
 /// Names of the entries of `dir`, sorted (hidden ones included).
