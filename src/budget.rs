@@ -121,7 +121,7 @@ pub fn check_horizon(dim: usize, dx: f64, rule: &HorizonRule) -> std::result::Re
         ));
     }
     let n = ball(dim, m);
-    if !(n <= MAX_NEIGHBOURS) {
+    if !crate::limits::within(n, MAX_NEIGHBOURS) {
         return Err(format!(
             "implies about {n:.3e} neighbours per node (δ/Δ = {m:.3e}); at most {MAX_NEIGHBOURS:e} are allowed"
         ));
@@ -152,7 +152,7 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
             for i in 0..cloud.n_body {
                 let m = cloud.horizon[i] / cloud.spacing[i] + band;
                 m_max = m_max.max(m);
-                if !(ball(dim, m) <= MAX_NEIGHBOURS) {
+                if !crate::limits::within(ball(dim, m), MAX_NEIGHBOURS) {
                     return Err(crate::Error::model(
                         format!("region[{}].horizon", cloud.region[i]),
                         format!(

@@ -1082,6 +1082,7 @@ impl CaseFile {
     fn validate(self, path: &Path) -> Result<Case> {
         let err = |key: &str, m: String| case_err(path, key, m);
         let dim = self.dimension;
+        let size_keys = self.size_keys();
         if !(1..=3).contains(&dim) {
             return Err(err("dimension", format!("must be 1, 2 or 3, got {dim}")));
         }
@@ -1503,7 +1504,6 @@ impl CaseFile {
             crack_correction: self.kernel.crack_correction,
             symmetry: self.symmetry,
         };
-        let size_keys = self.size_keys();
         let budget = crate::budget::estimate(&spec, &size_keys, integrator.is_implicit())
             .map_err(|e| in_case(path, e))?;
         Ok(Case {

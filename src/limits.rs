@@ -42,3 +42,9 @@ pub const FEM_BYTES_PER_ENTRY: f64 = 200.0;
 
 /// Fraction of the machine's available memory a run may plan to use without `--max-memory`.
 pub const MEMORY_FRACTION: f64 = 0.8;
+
+/// True when `v` is at most `limit`; false for NaN (a count that cannot be computed is refused).
+pub fn within(v: f64, limit: f64) -> bool {
+    v.partial_cmp(&limit)
+        .is_some_and(|o| o != std::cmp::Ordering::Greater)
+}

@@ -154,7 +154,7 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
     let total = if fixed {
         let end = case.outputs.last().copied().unwrap_or(case.end);
         let steps = end / dt;
-        if !(steps <= MAX_STEPS) {
+        if !crate::limits::within(steps, MAX_STEPS) {
             let (key, why) = match case.dt {
                 Some(_) => ("time.dt", format!("time.dt = {dt:e} s")),
                 None => (

@@ -303,7 +303,7 @@ pub fn run_fem(
 /// count beyond [`crate::limits::MAX_STEPS`].
 fn budget(case: &Case, opts: &FemOptions, dt: f64) -> Result<()> {
     let end = case.outputs.last().copied().unwrap_or(case.end);
-    if opts.scheme != Scheme::Steady && !(end / dt <= crate::limits::MAX_STEPS) {
+    if opts.scheme != Scheme::Steady && !crate::limits::within(end / dt, crate::limits::MAX_STEPS) {
         return Err(Error::model(
             "--dt",
             format!(
