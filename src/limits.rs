@@ -23,13 +23,13 @@ pub const MAX_STEPS: f64 = 1e8;
 pub const MAX_NEIGHBOURS: f64 = 2e4;
 
 /// Bytes of set-up and run memory per node (positions, spacings, volumes, state vectors, the
-/// boundary's tables and the search structures): a conservative round figure above the
-/// measured ≈ 400 B.
+/// boundary's tables and the search structures): a conservative round figure, not a
+/// measurement (about fifty f64 per node).
 pub const BYTES_PER_NODE: f64 = 1024.0;
 
 /// Bytes per directed bond at the peak of the set-up (neighbour lists of the search pass,
-/// bond weights and cut fractions, and the conductance's CSR column and value): measured
-/// ≈ 40 B; 64 keeps a margin.
+/// bond weights and cut fractions, and the conductance's CSR column and value): about 40 B
+/// counted from those arrays, not measured; 64 keeps a margin.
 pub const BYTES_PER_BOND: f64 = 64.0;
 
 /// Extra factor on the bond memory of the implicit integrators (the system matrix, its
