@@ -325,6 +325,46 @@ impl Reference {
 
     /// The parameters a series cannot be evaluated with, as a message (`None`: usable).
     pub fn check(&self) -> Option<String> {
+        // every parameter finite (non-finite numbers serialise as null), every length,
+        // diffusivity and material constant a normal positive number
+        let value = serde_json::to_value(self).unwrap_or_default();
+        for (name, v) in value.as_object().into_iter().flatten() {
+            let numbers: Vec<Option<f64>> = match v {
+                serde_json::Value::Array(a) if a.iter().any(|x| x.is_string()) => continue,
+                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+                serde_json::Value::String(_) => continue,
+                x => vec![x.as_f64()],
+            };
+            if numbers.iter().any(|x| x.is_none_or(|x| !x.is_finite())) {
+                return Some(format!("{name} must be finite, got {v}"));
+            }
+            let must_be_positive = ["length", "diffusivity", "radius", "density", "latent_heat"]
+                .iter()
+                .any(|k| name.contains(k))
+                || name.ends_with("conductivity")
+                || name.ends_with("specific_heat")
+                || name == "size";
+            if must_be_positive
+                && numbers
+                    .iter()
+                    .flatten()
+                    .any(|x| !(x.is_normal() && *x > 0.0))
+            {
+                return Some(format!("{name} must be > 0, got {v}"));
+            }
+        }
+        if let Reference::AnnulusSteady {
+            inner_radius,
+            outer_radius,
+            ..
+        } = self
+        {
+            if outer_radius <= inner_radius {
+                return Some(format!(
+                    "outer_radius {outer_radius} must exceed inner_radius {inner_radius}"
+                ));
+            }
+        }
         match self {
             Reference::BoxFixedFaces {
                 min,
@@ -845,6 +885,35 @@ mod tests {
         let text = "kind = \"box_fixed_faces\"\nmin = [0.0]\nsize = [1.0]\nends = [\"fixed_low\"]\ndiffusivity = 1.0\nedge = 0.0\ninitial = 1.0\n";
         let r: Reference = toml::from_str(text).unwrap();
         assert_eq!(r.check(), None);
+    }
+
+    /// Issue 15: every series' lengths and diffusivities are validated, and every parameter
+    /// must be finite (a length of 0 gave NaN, a diffusivity of −1 gave 3.5e169).
+    #[test]
+    fn every_series_parameter_is_validated() {
+        let bar = |length: f64, diffusivity: f64, initial: f64| Reference::BarFixedEnds {
+            x0: 0.0,
+            length,
+            diffusivity,
+            left: 0.0,
+            right: 0.0,
+            initial,
+        };
+        assert_eq!(bar(1.0, 1.0, 1.0).check(), None);
+        assert!(bar(0.0, 1.0, 1.0).check().unwrap().contains("length"));
+        assert!(bar(1.0, -1.0, 1.0).check().unwrap().contains("diffusivity"));
+        assert!(bar(1.0, 1e-320, 1.0)
+            .check()
+            .unwrap()
+            .contains("diffusivity"));
+        assert!(bar(1.0, 1.0, f64::NAN).check().unwrap().contains("initial"));
+        let annulus = Reference::AnnulusSteady {
+            inner_radius: 2.0,
+            outer_radius: 1.0,
+            inner: 0.0,
+            outer: 1.0,
+        };
+        assert!(annulus.check().unwrap().contains("outer_radius"));
     }
 
     fn water_freezing() -> Reference {

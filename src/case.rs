@@ -459,6 +459,8 @@ pub struct Case {
     pub outputs: Vec<f64>,
     /// Reference, if any.
     pub reference: Option<ReferenceSpec>,
+    /// The model's estimated size, checked against the memory before it is built.
+    pub budget: crate::budget::Estimate,
 }
 
 impl Case {
@@ -583,13 +585,18 @@ fn case_err(path: &Path, key: &str, message: impl Into<String>) -> Error {
 }
 
 fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
+    // subnormal values (below 2.2e-308) underflow in any product: refused as well
+    if v.is_normal() && v > 0.0 {
         Ok(v)
     } else {
         Err(case_err(
             path,
             key,
-            format!("must be a positive number, got {v}"),
+            if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+                format!("must be a positive number, got {v:e}")
+            } else {
+                format!("must be a positive number, got {v}")
+            },
         ))
     }
 }
@@ -612,6 +619,107 @@ fn coords(path: &Path, dim: usize, v: &[f64], key: &str) -> Result<[f64; 3]> {
     Ok(p)
 }
 
+/// The dotted key of region `r`'s horizon rule, `region[r].horizon.factor` or `.radius`.
+pub(crate) fn horizon_key(r: usize, reg: &RegionSpec) -> String {
+    match reg.horizon {
+        HorizonSpec::Factor(_) => format!("region[{r}].horizon.factor"),
+        HorizonSpec::Radius(_) => format!("region[{r}].horizon.radius"),
+    }
+}
+
+/// The points of `crack[c]`: coordinates of the dimension, no segment of zero length, and a
+/// path that enters the body's interior.
+fn crack_points(
+    path: &Path,
+    c: usize,
+    dim: usize,
+    pts: &[Vec<f64>],
+    geometry: &Geometry,
+) -> Result<Vec<Point>> {
+    let key = |k: &str| format!("crack[{c}].{k}");
+    let mut list: Vec<Point> = Vec::new();
+    for (k, p) in pts.iter().enumerate() {
+        let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
+        let q = Point::new(q[0], q[1], q[2]);
+        if list
+            .last()
+            .is_some_and(|l| (q - l).norm() <= 1e-12 * q.coords.amax())
+        {
+            return Err(case_err(
+                path,
+                &key(&format!("points[{k}]")),
+                "repeats the previous point: a crack segment of zero length",
+            ));
+        }
+        list.push(q);
+    }
+    let (lo, hi) = geometry_bounds(geometry, dim);
+    if !crosses_interior(&list, dim, lo, hi) {
+        return Err(case_err(
+            path,
+            &key("points"),
+            format!(
+                "the crack does not pass through the body's interior ({:?} to {:?} m): it lies outside it or along its boundary",
+                &lo[..dim],
+                &hi[..dim]
+            ),
+        ));
+    }
+    Ok(list)
+}
+
+/// The body's bounding box, m: a box's domain, a mesh's nodes (scaled).
+fn geometry_bounds(geometry: &Geometry, dim: usize) -> ([f64; 3], [f64; 3]) {
+    match geometry {
+        Geometry::Box(g) => (g.min, g.max),
+        Geometry::Mesh(g) => {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for p in &g.mesh.nodes {
+                for a in 0..dim {
+                    lo[a] = lo[a].min(p[a] * g.scale);
+                    hi[a] = hi[a].max(p[a] * g.scale);
+                }
+            }
+            (lo, hi)
+        }
+    }
+}
+
+/// True when a crack (2D polyline or 3D polygon) enters the open box (lo, hi) shrunk by a
+/// relative 1e-9: a 2D segment clipped to it keeps a positive length, a 3D polygon's bounding
+/// box overlaps it on every axis.
+fn crosses_interior(pts: &[Point], dim: usize, lo: [f64; 3], hi: [f64; 3]) -> bool {
+    let eps: Vec<f64> = (0..dim).map(|a| 1e-9 * (hi[a] - lo[a]).abs()).collect();
+    if dim == 3 {
+        return (0..3).all(|a| {
+            let (pmin, pmax) = pts
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                    (l.min(p[a]), h.max(p[a]))
+                });
+            pmin < hi[a] - eps[a] && pmax > lo[a] + eps[a]
+        });
+    }
+    // Liang–Barsky clipping of each segment
+    pts.windows(2).any(|w| {
+        let (p, d) = (w[0], w[1] - w[0]);
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for a in 0..dim {
+            let (l, h) = (lo[a] + eps[a], hi[a] - eps[a]);
+            if d[a] == 0.0 {
+                if p[a] <= l || p[a] >= h {
+                    return false;
+                }
+                continue;
+            }
+            let (ta, tb) = ((l - p[a]) / d[a], (h - p[a]) / d[a]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        t1 > t0
+    })
+}
+
 /// Keys a [`Error::Model`] from geometry validation to the case file.
 fn in_case(path: &Path, e: Error) -> Error {
     match e {
@@ -621,6 +729,19 @@ fn in_case(path: &Path, e: Error) -> Error {
 }
 
 impl CaseFile {
+    /// The key that sets each region's node count, for the budget's message.
+    fn size_keys(&self) -> Vec<String> {
+        self.region
+            .iter()
+            .enumerate()
+            .map(|(r, reg)| match (&self.mesh, &reg.cells) {
+                (Some(_), _) => "mesh.file".to_string(),
+                (None, Some(_)) => format!("region[{r}].cells"),
+                (None, None) => format!("region[{r}].spacing"),
+            })
+            .collect()
+    }
+
     /// The built-in box geometry of `[domain]` and the `[[region]]` boxes.
     fn box_geometry(
         &self,
@@ -695,14 +816,17 @@ impl CaseFile {
                     cells[..dim].copy_from_slice(c);
                 }
             }
-            regions.push(BoxRegion {
+            let region = BoxRegion {
                 name: reg.name.clone(),
                 min: rmin,
                 max: rmax,
                 cells,
                 horizon: rules[r].0,
                 material: rules[r].1,
-            });
+            };
+            crate::budget::check_horizon(dim, region.spacing(), &region.horizon)
+                .map_err(|m| err(&horizon_key(r, reg), m))?;
+            regions.push(region);
         }
         let g = BoxGeometry {
             dim,
@@ -864,11 +988,7 @@ impl CaseFile {
                             format!("needs at least {need} points"),
                         ));
                     }
-                    let mut list = Vec::new();
-                    for (k, p) in pts.iter().enumerate() {
-                        let q = coords(path, dim, p, &key(&format!("points[{k}]")))?;
-                        list.push(Point::new(q[0], q[1], q[2]));
-                    }
+                    let list = crack_points(path, c, dim, pts, geometry)?;
                     if dim == 2 {
                         CrackShape::Polyline(list)
                     } else {
@@ -935,6 +1055,17 @@ impl CaseFile {
                             format!("must be a length >= 0, got {initial}"),
                         ));
                     }
+                    let total = match &shape {
+                        CrackShape::Polyline(p) => p.windows(2).map(|w| (w[1] - w[0]).norm()).sum(),
+                        _ => f64::INFINITY,
+                    };
+                    if initial > total {
+                        return Err(case_err(
+                            path,
+                            &key("initial_length"),
+                            format!("{initial} m exceeds the length of the path, {total} m"),
+                        ));
+                    }
                     Some(Growth {
                         start,
                         speed: positive(path, &key("speed"), v)?,
@@ -951,6 +1082,7 @@ impl CaseFile {
     fn validate(self, path: &Path) -> Result<Case> {
         let err = |key: &str, m: String| case_err(path, key, m);
         let dim = self.dimension;
+        let size_keys = self.size_keys();
         if !(1..=3).contains(&dim) {
             return Err(err("dimension", format!("must be 1, 2 or 3, got {dim}")));
         }
@@ -1067,6 +1199,12 @@ impl CaseFile {
         let mut rules = Vec::new();
         for (r, reg) in self.region.iter().enumerate() {
             let key = |k: &str| format!("region[{r}].{k}");
+            if let Some(first) = self.region[..r].iter().position(|o| o.name == reg.name) {
+                return Err(err(
+                    &key("name"),
+                    format!("`{}` is also the name of region[{first}]", reg.name),
+                ));
+            }
             let horizon = match reg.horizon {
                 HorizonSpec::Factor(n) => {
                     HorizonRule::Factor(positive(path, &key("horizon.factor"), n)?)
@@ -1351,24 +1489,28 @@ impl CaseFile {
                 ));
             }
         }
+        let spec = ModelSpec {
+            geometry,
+            materials,
+            kernel,
+            bond_rule: self.kernel.bond_rule,
+            faces,
+            cracks,
+            source,
+            initial,
+            consistency: self
+                .kernel
+                .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
+            crack_correction: self.kernel.crack_correction,
+            symmetry: self.symmetry,
+        };
+        let budget = crate::budget::estimate(&spec, &size_keys, integrator.is_implicit())
+            .map_err(|e| in_case(path, e))?;
         Ok(Case {
             path: path.to_path_buf(),
             title: self.title,
-            spec: ModelSpec {
-                geometry,
-                materials,
-                kernel,
-                bond_rule: self.kernel.bond_rule,
-                faces,
-                cracks,
-                source,
-                initial,
-                consistency: self
-                    .kernel
-                    .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
-                crack_correction: self.kernel.crack_correction,
-                symmetry: self.symmetry,
-            },
+            spec,
+            budget,
             integrator,
             dt: self.time.dt,
             tolerance: self.time.tolerance,

@@ -9,6 +9,7 @@
 //! when a source is evaluated at every node of every step.
 
 use crate::error::{Error, Result};
+use crate::limits::{MAX_EXPR_DEPTH, MAX_EXPR_LEN};
 
 /// A parsed expression of (x, y, z, t); two expressions are equal when their texts are.
 #[derive(Debug, Clone)]
@@ -47,17 +48,35 @@ enum Op {
 }
 
 impl Expr {
-    /// Parses `text`; errors name the expression and the position.
+    /// Parses `text`; errors name the expression and the position. Texts longer than
+    /// [`MAX_EXPR_LEN`] and trees deeper than [`MAX_EXPR_DEPTH`] are refused, so neither the
+    /// parser nor the evaluator recurses without a bound.
     pub fn parse(text: &str) -> Result<Self> {
+        if text.len() > MAX_EXPR_LEN {
+            let head: String = text.chars().take(24).collect();
+            return Err(Error::Expr {
+                expr: format!("{head}…"),
+                message: format!(
+                    "is {} bytes long; at most {MAX_EXPR_LEN} are allowed",
+                    text.len()
+                ),
+            });
+        }
         let mut p = Parser {
             s: text.as_bytes(),
             i: 0,
             text,
+            depth: 0,
         };
         let root = p.comparison()?;
         p.skip_ws();
         if p.i != p.s.len() {
             return Err(p.err("unexpected character"));
+        }
+        if depth(&root) > MAX_EXPR_DEPTH {
+            return Err(p.err(&format!(
+                "nests deeper than {MAX_EXPR_DEPTH} levels; split it or simplify it"
+            )));
         }
         Ok(Expr {
             text: text.to_string(),
@@ -92,6 +111,24 @@ impl Expr {
     pub fn is_uniform(&self) -> bool {
         !uses(&self.root, 0) && !uses(&self.root, 1) && !uses(&self.root, 2)
     }
+}
+
+/// Depth of the tree, by an explicit stack (the tree may be deeper than the limit).
+fn depth(root: &Node) -> usize {
+    let mut stack = vec![(root, 1usize)];
+    let mut deepest = 0;
+    while let Some((n, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        match n {
+            Node::Num(_) | Node::Var(_) => {}
+            Node::Neg(a) | Node::F1(_, a) => stack.push((a, d + 1)),
+            Node::Bin(_, a, b) | Node::F2(_, a, b) => {
+                stack.push((a, d + 1));
+                stack.push((b, d + 1));
+            }
+        }
+    }
+    deepest
 }
 
 fn uses(n: &Node, var: usize) -> bool {
@@ -132,12 +169,20 @@ struct Parser<'a> {
     s: &'a [u8],
     i: usize,
     text: &'a str,
+    /// Current recursion depth of the descent (bounded by [`MAX_EXPR_DEPTH`]).
+    depth: usize,
 }
 
 impl Parser<'_> {
     fn err(&self, msg: &str) -> Error {
+        // a long text is shown by its head: the message stays one readable line
+        let expr = if self.text.len() > 80 {
+            format!("{}…", self.text.chars().take(40).collect::<String>())
+        } else {
+            self.text.to_string()
+        };
         Error::Expr {
-            expr: self.text.to_string(),
+            expr,
             message: format!("{msg} at position {}", self.i + 1),
         }
     }
@@ -158,7 +203,23 @@ impl Parser<'_> {
             false
         }
     }
+    /// Enters one level of recursion, refusing past [`MAX_EXPR_DEPTH`].
+    fn enter(&mut self) -> Result<()> {
+        self.depth += 1;
+        if self.depth > MAX_EXPR_DEPTH {
+            return Err(self.err(&format!(
+                "nests deeper than {MAX_EXPR_DEPTH} levels; split it or simplify it"
+            )));
+        }
+        Ok(())
+    }
     fn comparison(&mut self) -> Result<Node> {
+        self.enter()?;
+        let n = self.comparison_inner();
+        self.depth -= 1;
+        n
+    }
+    fn comparison_inner(&mut self) -> Result<Node> {
         let lhs = self.sum()?;
         let op = match self.peek() {
             Some(b'<') => Op::Lt,
@@ -207,6 +268,12 @@ impl Parser<'_> {
         }
     }
     fn unary(&mut self) -> Result<Node> {
+        self.enter()?;
+        let n = self.unary_inner();
+        self.depth -= 1;
+        n
+    }
+    fn unary_inner(&mut self) -> Result<Node> {
         if self.eat(b'-') {
             return Ok(Node::Neg(Box::new(self.unary()?)));
         }
@@ -355,6 +422,47 @@ mod tests {
                 .eval(1.0, 0.0, 0.0, 0.0),
             10.0
         );
+    }
+
+    /// The hostile inputs of issue 15 (each overflowed the stack before): refused with a
+    /// message, never a crash; the limits are those of [`crate::limits`].
+    #[test]
+    fn hostile_nesting_is_refused_not_overflowed() {
+        let hostile = [
+            format!("{}1{}", "(".repeat(7000), ")".repeat(7000)),
+            vec!["2"; 20_000].join("^"),
+            format!("{}1", "-".repeat(65_000)),
+            vec!["1"; 87_000].join("+"),
+            // within the length limit, beyond the depth limit
+            format!("{}1{}", "(".repeat(1000), ")".repeat(1000)),
+            format!("{}1", "-".repeat(2000)),
+            vec!["1"; 2000].join("+"),
+            vec!["2"; 1000].join("^"),
+            format!("{}1{}", "sin(".repeat(500), ")".repeat(500)),
+        ];
+        for text in &hostile {
+            let msg = Expr::parse(text).unwrap_err().to_string();
+            assert!(
+                msg.contains("at most") || msg.contains("deeper than"),
+                "{msg}"
+            );
+            assert!(msg.len() < 300, "one short line: {} bytes", msg.len());
+        }
+    }
+
+    /// The deepest accepted tree evaluates on a thread with a small (256 kB) stack.
+    #[test]
+    fn the_deepest_accepted_expression_evaluates_on_a_small_stack() {
+        let n = MAX_EXPR_DEPTH / 2 - 2;
+        let text = format!("{}1{}", "(1+".repeat(n), ")".repeat(n));
+        let e = Expr::parse(&text).unwrap();
+        let v = std::thread::Builder::new()
+            .stack_size(256 * 1024)
+            .spawn(move || e.eval(0.0, 0.0, 0.0, 0.0))
+            .unwrap()
+            .join()
+            .unwrap();
+        assert_eq!(v, (n + 1) as f64);
     }
 
     #[test]

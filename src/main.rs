@@ -5,12 +5,10 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use peritherm::case::Case;
 use peritherm::fem::{run_fem, FemOptions, Scheme};
-use peritherm::model::{crack_cutters, Model};
-use peritherm::output::read_field;
+use peritherm::model::crack_cutters;
 use peritherm::output::RunSummary;
 use peritherm::report::field_difference;
-use peritherm::run::run_case;
-use peritherm::solve::explicit::choose_dt;
+use peritherm::run::{run_case, run_case_with};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -25,6 +23,10 @@ struct Cli {
     /// Worker threads (default: all cores).
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Memory a run may plan to use, e.g. 8G or 512M (default: 80% of the machine's
+    /// available memory); a case estimated above it is refused before it is built.
+    #[arg(long, global = true, value_parser = peritherm::budget::parse_bytes)]
+    max_memory: Option<f64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -189,6 +191,11 @@ fn main() -> ExitCode {
 }
 
 fn real_main(cli: Cli) -> anyhow::Result<()> {
+    // SIGINT/SIGTERM: the run under way leaves a run.json saying so and no partial file
+    ctrlc::set_handler(|| peritherm::staging::interrupt()).context("signal handler")?;
+    let options = peritherm::prepare::Options {
+        max_memory: cli.max_memory,
+    };
     if let Some(n) = cli.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -208,7 +215,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 )
                 .expect("valid template"),
             );
-            let summary = run_case(&case, &out, |done, total| {
+            let summary = run_case_with(&case, &out, &options, |done, total| {
                 bar.set_length(total);
                 bar.set_position(done);
             })?;
@@ -332,45 +339,46 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             say!("{}", report.markdown());
             Ok(())
         }
-        Command::Check { case } => {
-            let case = Case::load(&case)?;
-            let model =
-                Model::build(&case.spec).with_context(|| case.path.display().to_string())?;
-            let bound = case.integrator.stable_dt(&model);
-            if case.integrator.is_implicit() {
-                say!(
-                    "{}: {} body nodes, {} fictitious, {} directed bonds, {}: no stability bound (explicit Euler's would be {:.4e} s)",
-                    case.path.display(),
-                    model.cloud.n_body,
-                    model.cloud.n_fictitious(),
-                    model.horizons.n_bonds(),
-                    case.integrator.name(),
-                    peritherm::solve::explicit::Integrator::Euler.stable_dt(&model)
-                );
-                if let Err(e) = peritherm::solve::implicit::System::build(&model) {
-                    anyhow::bail!("{}: {e}", case.path.display());
-                }
-            } else {
-                say!(
-                    "{}: {} body nodes, {} fictitious, {} directed bonds, stable dt ({}) = {:.4e} s",
-                    case.path.display(),
-                    model.cloud.n_body,
-                    model.cloud.n_fictitious(),
-                    model.horizons.n_bonds(),
-                    case.integrator.name(),
-                    bound
-                );
-            }
-            match choose_dt(&model, case.integrator, case.dt) {
-                Err(peritherm::Error::Model { key, message }) => {
-                    anyhow::bail!("{}: {key}: {message}", case.path.display())
-                }
-                Err(e) => anyhow::bail!("{}: time.dt: {e}", case.path.display()),
-                Ok(_) => {}
-            }
-            Ok(())
-        }
+        Command::Check { case } => check(&case, &options),
     }
+}
+
+/// `peritherm check`: everything `run` does before its time loop (the budget, the model, the
+/// semantic checks, the step and its count, the steppers' set-up), and the sizes.
+fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyhow::Result<()> {
+    use peritherm::solve::explicit::Integrator;
+    let case = Case::load(path)?;
+    say!("{}: {}", case.path.display(), case.budget.line());
+    let model = peritherm::prepare::build(&case, options)?;
+    let plan = peritherm::prepare::plan(&case, &model)?;
+    let sizes = format!(
+        "{}: {} body nodes, {} fictitious, {} directed bonds",
+        case.path.display(),
+        model.cloud.n_body,
+        model.cloud.n_fictitious(),
+        model.horizons.n_bonds()
+    );
+    let euler = Integrator::Euler.stable_dt(&model);
+    match (case.integrator.is_implicit(), plan.adaptive) {
+        (true, Some(a)) => say!(
+            "{sizes}, {}: adaptive steps of tolerance {:e} K (explicit Euler's bound would be {euler:.4e} s)",
+            case.integrator.name(),
+            a.tolerance
+        ),
+        (true, None) => say!(
+            "{sizes}, {}: no stability bound (explicit Euler's would be {euler:.4e} s), {} steps",
+            case.integrator.name(),
+            plan.total
+        ),
+        (false, _) => say!(
+            "{sizes}, stable dt ({}) = {:.4e} s, {} steps of {:.4e} s",
+            case.integrator.name(),
+            case.integrator.stable_dt(&model),
+            plan.total,
+            plan.dt
+        ),
+    }
+    Ok(())
 }
 
 /// Prints a run's comparison with its reference, one line per output time.
@@ -396,6 +404,9 @@ fn compare(
     reference: &std::path::Path,
     exclude_tips: f64,
 ) -> anyhow::Result<()> {
+    if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
+        anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
+    }
     let a = RunSummary::read(run)?;
     let b = RunSummary::read(reference)?;
     let case = Case::load(std::path::Path::new(&a.case))?;
@@ -429,8 +440,9 @@ fn compare(
         else {
             anyhow::bail!("{}: has no output at t = {t} s", reference.display());
         };
-        let fa = read_field(&run.join(&a.fields[k]))?;
-        let fb = read_field(&reference.join(&b.fields[kb]))?;
+        let fa = a.read_field(run, k)?;
+        let fb = b.read_field(reference, kb)?;
+        same_body(cloud.dim, (&fa.pos, run), (&fb.pos, reference))?;
         let tips = peritherm::crack::tips_at(&cracks, *t);
         let d = field_difference(
             cloud.dim,
@@ -452,6 +464,56 @@ fn compare(
     Ok(())
 }
 
+/// Refuses to compare fields of different dimension or of bodies that do not overlap: the
+/// nodes' coordinates span the same axes and each bounding box lies within the other's,
+/// up to 1% of the larger extent (node placement differs by half a spacing).
+fn same_body(
+    dim: usize,
+    a: (&[peritherm::math::Point], &std::path::Path),
+    b: (&[peritherm::math::Point], &std::path::Path),
+) -> anyhow::Result<()> {
+    let bounds = |pts: &[peritherm::math::Point]| {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in pts {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    };
+    let ((alo, ahi), (blo, bhi)) = (bounds(a.0), bounds(b.0));
+    let extent = (0..3)
+        .map(|k| (ahi[k] - alo[k]).max(bhi[k] - blo[k]))
+        .fold(0.0, f64::max);
+    let tol = 0.01 * extent.max(f64::MIN_POSITIVE);
+    for k in 0..3 {
+        let (sa, sb) = (ahi[k] - alo[k] > tol, bhi[k] - blo[k] > tol);
+        if sa != sb || (k >= dim && (sa || sb)) {
+            anyhow::bail!(
+                "{} and {}: the runs' nodes span different axes (a {dim}D run against another dimension); compare runs of the same body",
+                a.1.display(),
+                b.1.display()
+            );
+        }
+        if (alo[k] - blo[k]).abs() > tol + 0.05 * extent
+            || (ahi[k] - bhi[k]).abs() > tol + 0.05 * extent
+        {
+            anyhow::bail!(
+                "{} and {}: the runs' bodies differ along axis {k} ({:e}..{:e} m against {:e}..{:e} m); compare runs of the same body",
+                a.1.display(),
+                b.1.display(),
+                alo[k],
+                ahi[k],
+                blo[k],
+                bhi[k]
+            );
+        }
+    }
+    Ok(())
+}
+
 /// `peritherm sweep`: the variants of every case, run and compared; the table printed and
 /// written as sweep.csv and sweep.md.
 fn sweep(
@@ -462,6 +524,9 @@ fn sweep(
     exclude_tips: f64,
 ) -> anyhow::Result<()> {
     use peritherm::sweep::{self, Against};
+    if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
+        anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
+    }
     let mut variants = Vec::new();
     for path in cases {
         let text = std::fs::read_to_string(path)
@@ -525,10 +590,8 @@ fn plot(run: &std::path::Path) -> anyhow::Result<()> {
             run.display()
         );
     }
-    let fields = summary
-        .fields
-        .iter()
-        .map(|f| read_field(&run.join(f)))
+    let fields = (0..summary.fields.len())
+        .map(|k| summary.read_field(run, k))
         .collect::<Result<Vec<_>, _>>()?;
     for stem in peritherm::report::page::draw_maps(&case, &summary, &fields, run)? {
         say!("{}.png/.svg", stem.display());

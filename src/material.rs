@@ -124,7 +124,8 @@ impl Material {
     /// Checks every property: `Err((key, message))` names the offending key, e.g.
     /// `phase_change.latent_heat`.
     pub fn check(&self) -> Result<(), (String, String)> {
-        let positive = |v: f64| v.is_finite() && v > 0.0;
+        // subnormal values (below 2.2e-308) make ρc or 1/(Vρc) underflow or overflow
+        let positive = |v: f64| v.is_normal() && v > 0.0;
         let mut checks = vec![
             (
                 "conductivity",
@@ -186,10 +187,24 @@ impl Material {
                 ),
             ]);
         }
-        match checks.into_iter().find(|c| !c.2) {
-            Some((key, v, _, what)) => Err((key.to_string(), format!("must be {what}, got {v}"))),
-            None => Ok(()),
+        if let Some((key, v, _, what)) = checks.into_iter().find(|c| !c.2) {
+            // tiny and huge values in exponent form (a subnormal's digits fill a screen)
+            let v = if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+                format!("{v:e}")
+            } else {
+                format!("{v}")
+            };
+            return Err((key.to_string(), format!("must be {what}, got {v}")));
         }
+        // each factor may be normal while ρc or k/(ρc) is not
+        let (c, d) = (self.capacity(), self.diffusivity());
+        if !(c.is_normal() && d.is_normal()) {
+            return Err((
+                "specific_heat".to_string(),
+                format!("gives ρc = {c:e} J/(m³·K) and k/(ρc) = {d:e} m²/s, outside the range of doubles"),
+            ));
+        }
+        Ok(())
     }
 
     /// The material's enthalpy relation (formulation §6).

@@ -22,6 +22,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         path: path.to_path_buf(),
         error: source,
     };
+    // an interrupt waits for this write to end ([`crate::staging::interrupt`])
+    let _guard = crate::staging::writing();
     std::fs::write(&tmp, bytes).map_err(io)?;
     std::fs::rename(&tmp, path).map_err(io)
 }
@@ -214,6 +216,12 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         path: path.to_path_buf(),
         error,
     })?;
+    // every line of a complete file ends with a newline: a file cut mid-number does not
+    if !text.ends_with('\n') {
+        return Err(bad(
+            "does not end with a newline: the file is cut short".into()
+        ));
+    }
     let mut lines = text.lines();
     let header = lines.next().unwrap_or("");
     if !header.starts_with("x,y,z,temperature,region,spacing") {
@@ -242,6 +250,14 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         if v.len() < 6 {
             return Err(bad(format!("line {}: fewer than 6 columns", k + 2)));
         }
+        if let Some(c) = v.iter().position(|x| !x.is_finite()) {
+            return Err(bad(format!(
+                "line {}: column {} is {}, not a finite number",
+                k + 2,
+                c + 1,
+                v[c]
+            )));
+        }
         rows.pos.push(Point::new(v[0], v[1], v[2]));
         rows.theta.push(v[3]);
         rows.spacing.push(v[5]);
@@ -257,6 +273,9 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
         }
     }
     rows.reference = reference_column.map(|_| reference);
+    if rows.pos.is_empty() {
+        return Err(bad("has a header but no rows".into()));
+    }
     Ok(rows)
 }
 
@@ -300,6 +319,9 @@ pub struct Probe {
 /// Summary written to run.json.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunSummary {
+    /// `complete` (an unfinished run's run.json is a [`crate::staging::Unfinished`]).
+    #[serde(default = "complete")]
+    pub status: String,
     /// Case title.
     pub title: String,
     /// Case file.
@@ -356,6 +378,10 @@ fn peridynamics() -> String {
     "peridynamics".into()
 }
 
+fn complete() -> String {
+    "complete".into()
+}
+
 impl RunSummary {
     /// Reads `dir/run.json`.
     pub fn read(dir: &Path) -> Result<RunSummary> {
@@ -364,10 +390,84 @@ impl RunSummary {
             path: path.clone(),
             error,
         })?;
-        serde_json::from_str(&text).map_err(|e| Error::Io {
-            path,
-            error: std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()),
-        })
+        let bad = |m: String| Error::Io {
+            path: path.clone(),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        let status = value
+            .get("status")
+            .and_then(|s| s.as_str())
+            .map(str::to_string);
+        if let Some(status) = status {
+            if status != "complete" {
+                let u: crate::staging::Unfinished =
+                    serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+                return Err(bad(format!(
+                    "the run of {} is {status} at t = {:e} s ({}); it has no results to read, run it again",
+                    u.case, u.time, u.message
+                )));
+            }
+        }
+        let summary: RunSummary = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+        summary.check(dir)?;
+        Ok(summary)
+    }
+
+    /// Checks what a reader relies on: one field file per output time, one energy per
+    /// output, finite measures.
+    fn check(&self, dir: &Path) -> Result<()> {
+        let bad = |m: String| Error::Io {
+            path: dir.join("run.json"),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+        };
+        if self.fields.len() != self.output_times.len() {
+            return Err(bad(format!(
+                "lists {} field files for {} output times",
+                self.fields.len(),
+                self.output_times.len()
+            )));
+        }
+        if self.output_times.iter().any(|t| !t.is_finite()) {
+            return Err(bad("an output time is not finite".into()));
+        }
+        let measures = self.reference.iter().flat_map(|c| {
+            [
+                c.max_abs_diff,
+                c.mean_sq_rel_diff,
+                c.l2_rel_line,
+                c.epsilon,
+                c.l2_rel_volume,
+            ]
+        });
+        if measures.into_iter().any(|v| !v.is_finite()) {
+            return Err(bad(
+                "a comparison with the reference is not finite (NaN or infinite)".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads the k-th field (k from 0) of the run in `dir` and checks it is complete: one row
+    /// per body node (`nodes` of run.json), every value finite.
+    pub fn read_field(&self, dir: &Path, k: usize) -> Result<FieldRows> {
+        let path = dir.join(&self.fields[k]);
+        let rows = read_field(&path)?;
+        if rows.pos.len() != self.nodes {
+            return Err(Error::Io {
+                path,
+                error: std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!(
+                        "has {} rows but run.json says {} nodes: the file is incomplete or from another run",
+                        rows.pos.len(),
+                        self.nodes
+                    ),
+                ),
+            });
+        }
+        Ok(rows)
     }
 
     /// Markdown rows (one per output time) comparing this run with its reference.

@@ -8,96 +8,78 @@ use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::output::read_field;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
+use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
-use crate::solve::enthalpy::Enthalpic;
-use crate::solve::explicit::{choose_dt, count_steps, Explicit, Integrator};
-use crate::solve::implicit::{Adaptive, Implicit, Options, Scheme, Solver};
+use crate::solve::explicit::{Explicit, Integrator};
+use crate::staging::{reached, Staged};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
 /// Runs `case`, writing its outputs into `out`; `progress(done, total)` reports steps.
 pub fn run_case(case: &Case, out: &Path, progress: impl FnMut(u64, u64)) -> Result<RunSummary> {
+    run_case_with(case, out, &Options::default(), progress)
+}
+
+/// [`run_case`] with run options (the memory budget): the budget is checked before the model
+/// is built ([`crate::prepare::build`]).
+pub fn run_case_with(
+    case: &Case,
+    out: &Path,
+    options: &Options,
+    progress: impl FnMut(u64, u64),
+) -> Result<RunSummary> {
     let t_setup = Instant::now();
-    let model = Model::build(&case.spec).map_err(|e| match e {
-        Error::Model { key, message } => Error::Case {
-            file: case.path.clone(),
-            key,
-            message,
-        },
-        other => other,
-    })?;
+    let model = crate::prepare::build(case, options)?;
     run_model(case, &model, out, t_setup, progress)
 }
 
-/// Runs `case` on its already built `model` (set-up timed from `t_setup`), writing into `out`.
+/// Runs `case` on its already built `model` (set-up timed from `t_setup`), writing into `out`
+/// transactionally ([`crate::staging`]): nothing is written before the time loop is planned.
 pub fn run_model(
     case: &Case,
     model: &Model,
     out: &Path,
     t_setup: Instant,
+    progress: impl FnMut(u64, u64),
+) -> Result<RunSummary> {
+    let plan = plan(case, model)?;
+    let name = case.path.display().to_string();
+    let staged = Staged::begin(out, &name)?;
+    match execute(case, model, plan, staged.dir(), t_setup, progress) {
+        Ok(summary) => {
+            staged.commit()?;
+            Ok(summary)
+        }
+        Err(e) => {
+            // a refusal before anything was written leaves `out` as it was
+            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
+            if wrote {
+                staged.fail(&name, &e.to_string())?;
+            }
+            Err(e)
+        }
+    }
+}
+
+/// The time loop of a planned run, writing into the staged directory `out`.
+fn execute(
+    case: &Case,
+    model: &Model,
+    plan: Plan,
+    out: &Path,
+    t_setup: Instant,
     mut progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary> {
-    let in_case = |e: Error| match e {
-        Error::UnstableDt { .. } => Error::Case {
-            file: case.path.clone(),
-            key: "time.dt".into(),
-            message: e.to_string(),
-        },
-        Error::Model { key, message } => Error::Case {
-            file: case.path.clone(),
-            key,
-            message,
-        },
-        other => other,
-    };
-    let adaptive = case.tolerance.map(|tolerance| Adaptive {
-        tolerance,
-        first: case.dt,
-        max: case.dt_max,
-    });
-    // adaptive runs: dt is the first step (None: chosen from the tolerance)
-    let dt = match adaptive {
-        Some(_) => case.dt.unwrap_or(0.0),
-        None => choose_dt(model, case.integrator, case.dt).map_err(in_case)?,
-    };
-    let scheme = match case.integrator {
-        Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
-        Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
-        Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
-        Integrator::Euler | Integrator::Rk4 => None,
-    };
-    // phase change: the enthalpy form of forward Euler (seed 001), refusing other integrators
-    let mut enthalpic = match model.enthalpy {
-        Some(_) => Some(Enthalpic::new(model, case.integrator).map_err(in_case)?),
-        None => None,
-    };
-    // the implicit system (elimination, symbolic factorisation) is part of the set-up
-    let mut implicit = match scheme {
-        Some(s) => {
-            // adaptive steps visit several Δt: CG until a factorisation pays (Solver::Auto)
-            let options = Options {
-                solver: match adaptive {
-                    Some(_) => Solver::Auto,
-                    None => Solver::Direct,
-                },
-                ..Options::default()
-            };
-            Some(Implicit::new(model, s, options).map_err(in_case)?)
-        }
-        None => None,
-    };
+    let Plan {
+        dt,
+        adaptive,
+        total,
+        mut enthalpic,
+        mut implicit,
+    } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
-    std::fs::create_dir_all(out).map_err(|error| Error::Io {
-        path: out.to_path_buf(),
-        error,
-    })?;
-    let total = if case.integrator == Integrator::Steady || adaptive.is_some() {
-        0
-    } else {
-        count_steps(0.0, &case.outputs, dt)
-    };
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let mut energy = Vec::new();
@@ -109,48 +91,65 @@ pub fn run_model(
     let started = Instant::now();
     let reference = resolve_reference(case, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
-    let mut on_output =
-        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
-            energy.push(e);
-            let path = field_path(out, k + 1);
-            let flux = conductance.flux(&model.cloud, th);
-            let damage = model.damage_at(t);
-            let classical = match &reference {
-                Some(r) => {
-                    let started = Instant::now();
-                    let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                    let tips = tips_at(&cutters, t);
-                    comparisons.push(compare(&model.cloud, th, &classical, r, t, &tips));
-                    reference_seconds += started.elapsed().as_secs_f64();
-                    Some(classical)
+    let mut on_output = |k: usize,
+                         t: f64,
+                         th: &[f64],
+                         conductance: &crate::operator::Conductance,
+                         e: f64| {
+        energy.push(e);
+        let path = field_path(out, k + 1);
+        let flux = conductance.flux(&model.cloud, th);
+        let damage = model.damage_at(t);
+        let classical = match &reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
+                let tips = tips_at(&cutters, t);
+                let c = compare(&model.cloud, th, &classical, r, t, &tips);
+                let measures = [c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line, c.epsilon];
+                if measures.iter().any(|v| !v.is_finite()) {
+                    // finite values whose squares overflow: never an exact match
+                    return Err(Error::Case {
+                            file: case.path.clone(),
+                            key: "reference".into(),
+                            message: format!(
+                                "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
+                                c.max_abs_diff
+                            ),
+                        });
                 }
-                None => None,
-            };
-            let f = Fields {
-                theta: th,
-                damage: &damage,
-                flux: &flux,
-                reference: classical.as_deref(),
-            };
-            write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-            write_atomic(
-                &vtu_path(out, k + 1),
-                field_vtu(&model.cloud, &f).as_bytes(),
-            )?;
-            fields.push(
-                path.file_name()
-                    .expect("file")
-                    .to_string_lossy()
-                    .into_owned(),
-            );
-            Ok(())
+                comparisons.push(c);
+                reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
         };
+        let f = Fields {
+            theta: th,
+            damage: &damage,
+            flux: &flux,
+            reference: classical.as_deref(),
+        };
+        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic(
+            &vtu_path(out, k + 1),
+            field_vtu(&model.cloud, &f).as_bytes(),
+        )?;
+        fields.push(
+            path.file_name()
+                .expect("file")
+                .to_string_lossy()
+                .into_owned(),
+        );
+        Ok(())
+    };
     let linear_output = |k: usize, t: f64, th: &[f64], c: &crate::operator::Conductance| {
         on_output(k, t, th, c, model.energy(th))
     };
     let result = match (enthalpic.as_mut(), implicit.as_mut()) {
         (Some(stepper), _) => {
             stepper.run(&mut theta, 0.0, dt, &case.outputs, &mut on_output, |s| {
+                reached(s as f64 * dt);
                 progress(s, total)
             })
         }
@@ -167,11 +166,15 @@ pub fn run_model(
                 &case.outputs,
                 linear_output,
                 // the number of steps is not known: extrapolate it from the time reached
-                |s, t| progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64),
+                |s, t| {
+                    reached(t);
+                    progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64)
+                },
             )
         }
         (None, Some(stepper)) => {
             stepper.run(&mut theta, 0.0, dt, &case.outputs, linear_output, |s| {
+                reached(s as f64 * dt);
                 progress(s, total)
             })
         }
@@ -181,7 +184,10 @@ pub fn run_model(
             dt,
             &case.outputs,
             linear_output,
-            |s| progress(s, total),
+            |s| {
+                reached(s as f64 * dt);
+                progress(s, total)
+            },
         ),
     };
     let stats = result.map_err(|e| match e {
@@ -189,16 +195,17 @@ pub fn run_model(
             let p = model.cloud.pos[node];
             Error::Case {
                 file: case.path.clone(),
-                key: "state".into(),
+                key: likely_cause(case, model, node, time),
                 message: format!(
-                    "temperature became non-finite near ({}, {}, {}) by t = {time:e} s; check source, boundary values and dt",
+                    "temperature became non-finite near ({}, {}, {}) by t = {time:e} s; this key most likely caused it (else check the source, boundary values and time.dt)",
                     p.x, p.y, p.z
                 ),
             }
         }
-        other => other,
+        other => keyed(case, other),
     })?;
     let summary = RunSummary {
+        status: "complete".into(),
         title: case.title.clone(),
         case: case.path.display().to_string(),
         solver: "peridynamics".into(),

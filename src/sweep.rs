@@ -7,7 +7,7 @@ use crate::case::{Case, ReferenceSource};
 use crate::crack::tips_at;
 use crate::error::{Error, Result};
 use crate::model::crack_cutters;
-use crate::output::{read_field, RunSummary};
+use crate::output::RunSummary;
 use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
 use crate::report::field_difference;
 use crate::report::page::probe_lines;
@@ -445,8 +445,8 @@ pub fn run(
                     message: format!("has no output at t = {t} s, which {} writes", v.label),
                 });
             };
-            let a = read_field(&dir.join(&summary.fields[i]))?;
-            let b = read_field(&reference_dir.join(&reference.fields[j]))?;
+            let a = summary.read_field(&dir, i)?;
+            let b = reference.read_field(&reference_dir, j)?;
             let tips = tips_at(&cracks, *t);
             let d = field_difference(
                 cloud.dim,
@@ -646,7 +646,7 @@ pub fn line_plots(
                 .iter()
                 .position(|x| (x - t).abs() <= 1e-9 * t.abs())
             {
-                per_variant.push((v, read_field(&dir.join(&s.fields[i]))?));
+                per_variant.push((v, s.read_field(&dir, i)?));
             }
         }
         let Some((v0, f0)) = per_variant.first() else {
@@ -657,7 +657,7 @@ pub fn line_plots(
                 .output_times
                 .iter()
                 .position(|x| (x - t).abs() <= 1e-9 * t.abs())
-                .map(|i| read_field(&d.join(&s.fields[i])))
+                .map(|i| s.read_field(d, i))
                 .transpose()?,
             _ => None,
         };

@@ -1,8 +1,9 @@
-//! Every bundled case parses, builds, honours its own stability bound and runs a few steps
-//! (each model is built once and reused for the run).
+//! Every bundled case parses, passes the validation path of `check` and `run`
+//! ([`peritherm::prepare`]: budget, model, semantic checks, and the plan of the time loop
+//! inside `run_model`), honours its own stability bound and runs a few steps (each model is
+//! built once and reused for the run).
 
 use peritherm::case::Case;
-use peritherm::model::Model;
 use peritherm::run::run_model;
 use std::path::Path;
 
@@ -19,7 +20,8 @@ fn every_case_builds_and_starts() {
     for path in names {
         let started = std::time::Instant::now();
         let mut case = Case::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let model = Model::build(&case.spec).unwrap();
+        let model =
+            peritherm::prepare::build(&case, &Default::default()).unwrap_or_else(|e| panic!("{e}"));
         let bound = case.integrator.stable_dt(&model);
         if let Some(dt) = case.dt {
             assert!(

@@ -221,7 +221,8 @@ fn bad_input_fails_with_one_clear_line() {
         );
         assert!(!out.exists(), "{what}: output written");
     }
-    // NaN that appears during the run: one line, no run.json, no partial file
+    // NaN that appears during the run: one line; run.json says the run failed (issue 15),
+    // no partial file
     let case = write_case(
         dir.path(),
         "inf.toml",
@@ -236,7 +237,10 @@ fn bad_input_fails_with_one_clear_line() {
         err.contains("inf.toml") && err.contains("non-finite"),
         "{err}"
     );
-    assert!(!out.join("run.json").exists());
+    if out.exists() {
+        let json = std::fs::read_to_string(out.join("run.json")).unwrap();
+        assert!(json.contains("\"failed\""), "{json}");
+    }
     let o = peritherm(&["run", "/nonexistent/case.toml", "--out", "x"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/case.toml"));

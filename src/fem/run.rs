@@ -269,7 +269,7 @@ pub fn run_fem(
     case: &Case,
     out: &Path,
     opts: &FemOptions,
-    mut progress: impl FnMut(u64, u64),
+    progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary> {
     let t_setup = Instant::now();
     let dt = opts.dt.unwrap_or_else(|| default_dt(case));
@@ -279,12 +279,81 @@ pub fn run_fem(
             Error::model("--dt", format!("fem: must be a positive step, got {dt}")),
         ));
     }
+    budget(case, opts, dt).map_err(|e| keyed(case, e))?;
     let model = FemModel::build_with(case, opts).map_err(|e| keyed(case, e))?;
+    let name = case.path.display().to_string();
+    let staged = crate::staging::Staged::begin(out, &name)?;
+    match solve(case, &model, staged.dir(), opts, dt, t_setup, progress) {
+        Ok(summary) => {
+            staged.commit()?;
+            Ok(summary)
+        }
+        Err(e) => {
+            // a refusal before anything was written leaves `out` as it was
+            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
+            if wrote {
+                staged.fail(&name, &e.to_string())?;
+            }
+            Err(e)
+        }
+    }
+}
+
+/// Refuses, before anything is allocated, a structured box mesh beyond the memory and a step
+/// count beyond [`crate::limits::MAX_STEPS`].
+fn budget(case: &Case, opts: &FemOptions, dt: f64) -> Result<()> {
+    let end = case.outputs.last().copied().unwrap_or(case.end);
+    if opts.scheme != Scheme::Steady && !crate::limits::within(end / dt, crate::limits::MAX_STEPS) {
+        return Err(Error::model(
+            "--dt",
+            format!(
+                "fem: {:.3e} steps of {dt:e} s to reach {end} s; at most {:e} are allowed",
+                end / dt,
+                crate::limits::MAX_STEPS
+            ),
+        ));
+    }
+    let Geometry::Box(g) = &case.spec.geometry else {
+        return Ok(());
+    };
+    let finest = g
+        .regions
+        .iter()
+        .map(|r| r.spacing())
+        .fold(f64::INFINITY, f64::min);
+    let h = opts.h.unwrap_or(finest);
+    let size: Vec<f64> = (0..g.dim).map(|a| g.max[a] - g.min[a]).collect();
+    let (nodes, bytes) = crate::budget::fem_box(&size, h);
+    let estimate = crate::budget::Estimate {
+        nodes,
+        fictitious: 0.0,
+        bonds: 0.0,
+        bytes,
+        key: "--h".into(),
+    };
+    estimate.enforce(None).map_err(|m| {
+        Error::model(
+            if opts.h.is_some() {
+                "--h"
+            } else {
+                "region.spacing"
+            },
+            format!("fem: h = {h:e} m {m}"),
+        )
+    })
+}
+
+/// The time loop of the FEM solve, writing into the staged directory `out`.
+fn solve(
+    case: &Case,
+    model: &FemModel,
+    out: &Path,
+    opts: &FemOptions,
+    dt: f64,
+    t_setup: Instant,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunSummary> {
     let mut stepper = Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme);
-    std::fs::create_dir_all(out).map_err(|error| Error::Io {
-        path: out.to_path_buf(),
-        error,
-    })?;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     let total: u64 = match opts.scheme {
         Scheme::Steady => case.outputs.len() as u64,
@@ -366,6 +435,7 @@ pub fn run_fem(
         fields.push(format!("field_{}.csv", k + 1));
     }
     let summary = RunSummary {
+        status: "complete".into(),
         title: case.title.clone(),
         case: case.path.display().to_string(),
         solver: "fem".into(),

@@ -23,6 +23,35 @@ pub fn classical_at(
     t: f64,
     cracks: &[Cutter],
 ) -> Result<Vec<f64>> {
+    let values = classical_values(cloud, source, t, cracks)?;
+    // a NaN or infinite reference would compare as an exact match (NaN > x is false)
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(values),
+        Some(i) => {
+            let p = cloud.pos[i];
+            let (file, key) = match source {
+                ReferenceSource::Table(table) => (table.path.clone(), format!("t = {t}")),
+                _ => (Default::default(), "reference.solution".to_string()),
+            };
+            let message = format!(
+                "the reference is {} at the node ({}, {}, {}) at t = {t} s; check its parameters",
+                values[i], p.x, p.y, p.z
+            );
+            Err(match source {
+                ReferenceSource::Table(_) => Error::Case { file, key, message },
+                _ => Error::model(key, message),
+            })
+        }
+    }
+}
+
+/// [`classical_at`] before the check that every value is finite.
+fn classical_values(
+    cloud: &Cloud,
+    source: &ReferenceSource,
+    t: f64,
+    cracks: &[Cutter],
+) -> Result<Vec<f64>> {
     let nodes = &cloud.pos[..cloud.n_body];
     match source {
         ReferenceSource::Analytic(r) => Ok(r.eval_many(nodes, t)),

@@ -7,7 +7,7 @@ use crate::crack::segments_at;
 use crate::error::Result;
 use crate::math::Point;
 use crate::model::crack_cutters;
-use crate::output::{read_field, write_atomic, FieldRows, RunSummary};
+use crate::output::{write_atomic, FieldRows, RunSummary};
 use crate::plot::{
     field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
@@ -196,10 +196,8 @@ pub fn write_report(
         error,
     })?;
     let summary = RunSummary::read(run)?;
-    let fields = summary
-        .fields
-        .iter()
-        .map(|f| read_field(&run.join(f)))
+    let fields = (0..summary.fields.len())
+        .map(|k| summary.read_field(run, k))
         .collect::<Result<Vec<_>>>()?;
     let dim = case.spec.geometry.bare_cloud()?.dim;
     let extra_fields = match extra {
@@ -212,7 +210,7 @@ pub fn write_report(
                     .iter()
                     .position(|x| (x - t).abs() <= 1e-9 * t.abs());
                 by_output.push(match k {
-                    Some(k) => Some(read_field(&d.join(&s.fields[k]))?),
+                    Some(k) => Some(s.read_field(d, k)?),
                     None => None,
                 });
             }

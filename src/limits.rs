@@ -1,0 +1,50 @@
+//! The limits that keep hostile input from crashing, hanging or exhausting the machine, in
+//! one place. Each value is far above what any bundled case needs (stated per constant) and
+//! far below what would take a machine down; a case beyond one is refused up front with the
+//! count and the key to change (see `docs/robustness.md`).
+
+/// Longest expression string, bytes. The longest bundled expression is under 100 bytes; 4096
+/// bounds the parse tree to a depth the evaluator's recursion handles on any thread's stack.
+pub const MAX_EXPR_LEN: usize = 4096;
+
+/// Deepest expression tree (nested parentheses, signs, powers, calls and chained operators
+/// each add a level). Bundled expressions are under 10 deep; at 256 the recursive evaluation
+/// uses a few tens of kB of stack, within a worker thread's 2 MiB.
+pub const MAX_EXPR_DEPTH: usize = 256;
+
+/// Most time steps of a fixed-step run (explicit or implicit). The bundled cases take under
+/// 10⁶; 10⁸ steps of even a 1 000-node model run for hours, so more is a mistake in
+/// `time.dt` or `time.end` (or a material that makes the stable step vanish).
+pub const MAX_STEPS: f64 = 1e8;
+
+/// Most neighbours per node the horizon may imply (the lattice count of its ball, δ/Δ = m:
+/// 2m in 1D, πm² in 2D, 4πm³/3 in 3D). The bundled cases have under 1 000 (m = 6 in 3D);
+/// 20 000 allows m ≈ 80 in 2D and m ≈ 16 in 3D, beyond any convergence study.
+pub const MAX_NEIGHBOURS: f64 = 2e4;
+
+/// Bytes of set-up and run memory per node (positions, spacings, volumes, state vectors, the
+/// boundary's tables and the search structures): a conservative round figure, not a
+/// measurement (about fifty f64 per node).
+pub const BYTES_PER_NODE: f64 = 1024.0;
+
+/// Bytes per directed bond at the peak of the set-up (neighbour lists of the search pass,
+/// bond weights and cut fractions, and the conductance's CSR column and value): about 40 B
+/// counted from those arrays, not measured; 64 keeps a margin.
+pub const BYTES_PER_BOND: f64 = 64.0;
+
+/// Extra factor on the bond memory of the implicit integrators (the system matrix, its
+/// elimination and the sparse factor's fill).
+pub const IMPLICIT_BOND_FACTOR: f64 = 4.0;
+
+/// Bytes per stored entry of the FEM reference's matrices (mass and stiffness in CSR, and the
+/// sparse Cholesky factor's fill, taken as ten times the entries).
+pub const FEM_BYTES_PER_ENTRY: f64 = 200.0;
+
+/// Fraction of the machine's available memory a run may plan to use without `--max-memory`.
+pub const MEMORY_FRACTION: f64 = 0.8;
+
+/// True when `v` is at most `limit`; false for NaN (a count that cannot be computed is refused).
+pub fn within(v: f64, limit: f64) -> bool {
+    v.partial_cmp(&limit)
+        .is_some_and(|o| o != std::cmp::Ordering::Greater)
+}

@@ -1,0 +1,253 @@
+//! The one validation path of `check` and `run`: the memory budget before anything is
+//! allocated, the model, the semantic checks a valid-looking case can still fail, and the
+//! plan of the time loop (step, step count, steppers). `check` stops here; `run` goes on.
+
+use crate::bc::FaceBc;
+use crate::case::Case;
+use crate::cloud::FACE_NAMES;
+use crate::error::{Error, Result};
+use crate::limits::MAX_STEPS;
+use crate::model::{Geometry, Model};
+use crate::solve::enthalpy::Enthalpic;
+use crate::solve::explicit::{choose_dt, count_steps, Integrator};
+use crate::solve::implicit::{Adaptive, Implicit, Options as ImplicitOptions, Scheme, Solver};
+
+/// Settings of a run that are not part of the case.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Options {
+    /// Memory a run may plan to use, bytes (None: a fraction of the machine's available).
+    pub max_memory: Option<f64>,
+}
+
+/// The time loop a run will execute, validated.
+pub struct Plan<'a> {
+    /// The fixed step (adaptive: the first one, 0 when chosen from the tolerance), s.
+    pub dt: f64,
+    /// Adaptive step control of the implicit schemes.
+    pub adaptive: Option<Adaptive>,
+    /// Steps of a fixed-step run (0 when not known up front).
+    pub total: u64,
+    /// The enthalpy stepper of a phase-change model.
+    pub enthalpic: Option<Enthalpic<'a>>,
+    /// The implicit stepper (system eliminated and factorised symbolically).
+    pub implicit: Option<Implicit<'a>>,
+}
+
+/// A library error keyed to the case file.
+pub fn keyed(case: &Case, e: Error) -> Error {
+    match e {
+        Error::Model { key, message } => Error::Case {
+            file: case.path.clone(),
+            key,
+            message,
+        },
+        Error::UnstableDt { .. } => Error::Case {
+            file: case.path.clone(),
+            key: "time.dt".into(),
+            message: e.to_string(),
+        },
+        other => other,
+    }
+}
+
+/// Checks the budget, builds the model and runs the semantic checks on it.
+pub fn build(case: &Case, options: &Options) -> Result<Model> {
+    case.budget
+        .enforce(options.max_memory)
+        .map_err(|message| Error::Case {
+            file: case.path.clone(),
+            key: case.budget.key.clone(),
+            message,
+        })?;
+    let model = Model::build(&case.spec).map_err(|e| keyed(case, e))?;
+    semantic(case, &model).map_err(|e| keyed(case, e))?;
+    Ok(model)
+}
+
+/// What a model built from valid keys can still get wrong: regions without nodes, nodes
+/// without bonds (a horizon below the spacing), two nodes at one point (a duplicated mesh
+/// element), and a stable step that vanishes.
+pub fn semantic(case: &Case, model: &Model) -> Result<()> {
+    let cloud = &model.cloud;
+    let regions = match &case.spec.geometry {
+        Geometry::Box(g) => g.regions.len(),
+        Geometry::Mesh(g) => g.regions.len(),
+    };
+    let mut count = vec![0usize; regions];
+    for &r in &cloud.region[..cloud.n_body] {
+        if let Some(c) = count.get_mut(r as usize) {
+            *c += 1;
+        }
+    }
+    if let Some(r) = count.iter().position(|&c| c == 0) {
+        return Err(Error::model(
+            format!("region[{r}].name"),
+            "the region has no nodes (no element of the mesh's group, or no cell)",
+        ));
+    }
+    let lonely: Vec<usize> = (0..cloud.n_body)
+        .filter(|&i| model.horizons.row(i).next().is_none())
+        .collect();
+    if let Some(&i) = lonely.first() {
+        return Err(Error::model(
+            format!("region[{}].horizon", cloud.region[i]),
+            format!(
+                "{} of {} body nodes have no bond (first at ({}, {}, {}) m, spacing {:e} m, horizon {:e} m): the horizon must reach the neighbouring nodes",
+                lonely.len(),
+                cloud.n_body,
+                cloud.pos[i].x,
+                cloud.pos[i].y,
+                cloud.pos[i].z,
+                cloud.spacing[i],
+                cloud.horizon[i]
+            ),
+        ));
+    }
+    duplicates(case, model)
+}
+
+/// Refuses two body nodes at one point (a duplicated mesh element): their bond has zero
+/// length and the stable step vanishes.
+fn duplicates(case: &Case, model: &Model) -> Result<()> {
+    let cloud = &model.cloud;
+    let mut order: Vec<usize> = (0..cloud.n_body).collect();
+    let key = |i: usize| [cloud.pos[i].x, cloud.pos[i].y, cloud.pos[i].z];
+    order.sort_unstable_by(|&a, &b| {
+        let (ka, kb) = (key(a), key(b));
+        ka[0]
+            .total_cmp(&kb[0])
+            .then(ka[1].total_cmp(&kb[1]))
+            .then(ka[2].total_cmp(&kb[2]))
+    });
+    for w in order.windows(2) {
+        let d = (cloud.pos[w[0]] - cloud.pos[w[1]]).norm();
+        if d <= 1e-9 * cloud.spacing[w[0]].min(cloud.spacing[w[1]]) {
+            let p = cloud.pos[w[0]];
+            let key = match case.spec.geometry {
+                Geometry::Mesh(_) => "mesh.file".to_string(),
+                Geometry::Box(_) => format!("region[{}]", cloud.region[w[0]]),
+            };
+            return Err(Error::model(
+                key,
+                format!(
+                    "two nodes at ({}, {}, {}) m: a duplicated element (or overlapping regions)",
+                    p.x, p.y, p.z
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Validates and sets up the time loop of `case` on `model`.
+pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
+    let adaptive = case.tolerance.map(|tolerance| Adaptive {
+        tolerance,
+        first: case.dt,
+        max: case.dt_max,
+    });
+    let dt = match adaptive {
+        Some(_) => case.dt.unwrap_or(0.0),
+        None => choose_dt(model, case.integrator, case.dt).map_err(|e| keyed(case, e))?,
+    };
+    let fixed = case.integrator != Integrator::Steady && adaptive.is_none();
+    let total = if fixed {
+        let end = case.outputs.last().copied().unwrap_or(case.end);
+        let steps = end / dt;
+        if !crate::limits::within(steps, MAX_STEPS) {
+            let (key, why) = match case.dt {
+                Some(_) => ("time.dt", format!("time.dt = {dt:e} s")),
+                None => (
+                    "time.end",
+                    format!(
+                        "the stable step {dt:e} s of {} (set by the materials and the spacing)",
+                        case.integrator.name()
+                    ),
+                ),
+            };
+            return Err(Error::Case {
+                file: case.path.clone(),
+                key: key.into(),
+                message: format!(
+                    "{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"
+                ),
+            });
+        }
+        count_steps(0.0, &case.outputs, dt)
+    } else {
+        0
+    };
+    let scheme = match case.integrator {
+        Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
+        Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
+        Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
+        Integrator::Euler | Integrator::Rk4 => None,
+    };
+    // phase change: the enthalpy form of forward Euler (seed 001), refusing other integrators
+    let enthalpic = match model.enthalpy {
+        Some(_) => Some(Enthalpic::new(model, case.integrator).map_err(|e| keyed(case, e))?),
+        None => None,
+    };
+    // the implicit system (elimination, symbolic factorisation) is part of the set-up
+    let implicit = match scheme {
+        Some(s) => {
+            // adaptive steps visit several Δt: CG until a factorisation pays (Solver::Auto)
+            let options = ImplicitOptions {
+                solver: match adaptive {
+                    Some(_) => Solver::Auto,
+                    None => Solver::Direct,
+                },
+                ..ImplicitOptions::default()
+            };
+            Some(Implicit::new(model, s, options).map_err(|e| keyed(case, e))?)
+        }
+        None => None,
+    };
+    Ok(Plan {
+        dt,
+        adaptive,
+        total,
+        enthalpic,
+        implicit,
+    })
+}
+
+/// The key that most likely made the state non-finite at node `node` by time `t`: a source or
+/// a boundary value that is non-finite or huge there, else the step.
+pub fn likely_cause(case: &Case, model: &Model, node: usize, t: f64) -> String {
+    let p = model.cloud.pos[node];
+    let bad = |e: &crate::expr::Expr| {
+        [0.0, t].iter().any(|&s| {
+            let v = e.eval(p.x, p.y, p.z, s);
+            !v.is_finite() || v.abs() > 1e100
+        })
+    };
+    if case.spec.source.as_ref().is_some_and(bad) {
+        return "source.value".into();
+    }
+    let names: Vec<String> = match &case.spec.geometry {
+        Geometry::Box(_) => FACE_NAMES.iter().map(|s| s.to_string()).collect(),
+        Geometry::Mesh(g) => g.set_names(),
+    };
+    for (f, face) in case.spec.faces.iter().enumerate() {
+        let (e, k) = match face {
+            FaceBc::NodalTemperature { value, .. }
+            | FaceBc::LayerTemperature { value, .. }
+            | FaceBc::LayerFlux { value }
+            | FaceBc::RelationFlux { value } => (value, "value"),
+            FaceBc::Convection { ambient, .. } | FaceBc::LayerConvection { ambient, .. } => {
+                (ambient, "ambient")
+            }
+            _ => continue,
+        };
+        if bad(e) {
+            let name = names.get(f).cloned().unwrap_or_else(|| "-".into());
+            return format!("boundary.{name}.{k}");
+        }
+    }
+    match (&case.spec.source, case.dt) {
+        (_, Some(_)) => "time.dt".into(),
+        (Some(_), None) => "source.value".into(),
+        (None, None) => "time.dt".into(),
+    }
+}
