@@ -12,7 +12,7 @@ use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
 use crate::solve::explicit::{Explicit, Integrator};
-use crate::staging::{reached, Staged};
+use crate::staging::{reached, write_into};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -46,21 +46,9 @@ pub fn run_model(
 ) -> Result<RunSummary> {
     let plan = plan(case, model)?;
     let name = case.path.display().to_string();
-    let staged = Staged::begin(out, &name)?;
-    match execute(case, model, plan, staged.dir(), t_setup, progress) {
-        Ok(summary) => {
-            staged.commit()?;
-            Ok(summary)
-        }
-        Err(e) => {
-            // a refusal before anything was written leaves `out` as it was
-            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
-            if wrote {
-                staged.fail(&name, &e.to_string())?;
-            }
-            Err(e)
-        }
-    }
+    write_into(out, &name, |dir| {
+        execute(case, model, plan, dir, t_setup, progress)
+    })
 }
 
 /// The time loop of a planned run, writing into the staged directory `out`.

@@ -65,6 +65,26 @@ fn is_ours(name: &str) -> bool {
             .any(|p| name.starts_with(p))
 }
 
+/// Runs `write` into a staged copy of `out` for the run of `case` and swaps it in when it
+/// succeeds; a failure after something was written leaves a run.json saying so, a refusal
+/// before anything was written leaves `out` as it was.
+pub fn write_into<T>(out: &Path, case: &str, write: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
+    let staged = Staged::begin(out, case)?;
+    match write(staged.dir()) {
+        Ok(value) => {
+            staged.commit()?;
+            Ok(value)
+        }
+        Err(e) => {
+            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
+            if wrote {
+                staged.fail(case, &e.to_string())?;
+            }
+            Err(e)
+        }
+    }
+}
+
 /// An output directory being written: files go into [`Staged::dir`] until [`Staged::commit`].
 #[derive(Debug)]
 pub struct Staged {

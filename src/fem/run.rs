@@ -282,21 +282,9 @@ pub fn run_fem(
     budget(case, opts, dt).map_err(|e| keyed(case, e))?;
     let model = FemModel::build_with(case, opts).map_err(|e| keyed(case, e))?;
     let name = case.path.display().to_string();
-    let staged = crate::staging::Staged::begin(out, &name)?;
-    match solve(case, &model, staged.dir(), opts, dt, t_setup, progress) {
-        Ok(summary) => {
-            staged.commit()?;
-            Ok(summary)
-        }
-        Err(e) => {
-            // a refusal before anything was written leaves `out` as it was
-            let wrote = std::fs::read_dir(staged.dir()).is_ok_and(|mut d| d.next().is_some());
-            if wrote {
-                staged.fail(&name, &e.to_string())?;
-            }
-            Err(e)
-        }
-    }
+    crate::staging::write_into(out, &name, |dir| {
+        solve(case, &model, dir, opts, dt, t_setup, progress)
+    })
 }
 
 /// Refuses, before anything is allocated, a structured box mesh beyond the memory and a step
