@@ -138,9 +138,151 @@ fn phi(xi: &Vector, s: Real, used: &Mom) -> Mom {
     .component_mul(used)
 }
 
-impl Problem<'_> {
+/// The moment components in use for `dim` and `order`.
+fn used_components(dim: usize, order: Order) -> Mom {
+    let mut used = Mom::zeros();
+    for a in 0..dim {
+        used[a] = 1.0;
+    }
+    if order == Order::Quadratic {
+        // xx, yy, zz, xy, xz, yz: used when every axis they name exists
+        let axes: [&[usize]; 6] = [&[0], &[1], &[2], &[0, 1], &[0, 2], &[1, 2]];
+        for (c, ax) in axes.iter().enumerate() {
+            if ax.iter().all(|&a| a < dim) {
+                used[3 + c] = 1.0;
+            }
+        }
+    }
+    used
+}
+
+impl<'a> Problem<'a> {
+    /// The problem of meeting `order`'s moments at the nodes `sel` of `cloud` for the
+    /// conductances `k` and the conductivities `conductivity` (W/(m·K)).
+    fn new(
+        k: &'a Conductance,
+        cloud: &'a Cloud,
+        sel: &[bool],
+        conductivity: &[Real],
+        order: Order,
+    ) -> Problem<'a> {
+        let n = k.n_rows();
+        let dim = cloud.dim;
+        let quad = order == Order::Quadratic;
+        let target: Vec<Mom> = (0..n)
+            .map(|i| {
+                let mut t = Mom::zeros();
+                if quad {
+                    let s = cloud.horizon[i];
+                    for a in 0..dim {
+                        t[3 + a] = 2.0 * conductivity[i] * cloud.volume[i] / (s * s);
+                    }
+                }
+                t
+            })
+            .collect();
+        let mut p = Problem {
+            cloud,
+            offsets: &k.offsets,
+            cols: &k.cols,
+            k0: k.vals.clone(),
+            sel: sel[..n].to_vec(),
+            used: used_components(dim, order),
+            target,
+            unit: Vec::new(),
+        };
+        // unit of node i: its diagonal target second moment, or (linear) the present one
+        p.unit = (0..n)
+            .map(|i| {
+                let s2 = cloud.horizon[i] * cloud.horizon[i];
+                let present: Real = (k.offsets[i]..k.offsets[i + 1])
+                    .map(|e| {
+                        p.k0[e] * (cloud.pos[k.cols[e] as usize] - cloud.pos[i]).norm_squared()
+                    })
+                    .sum::<Real>()
+                    / (s2 * dim as Real);
+                let u = if quad { p.target[i][3] } else { present };
+                if u > 0.0 && p.sel[i] {
+                    u
+                } else {
+                    Real::INFINITY
+                }
+            })
+            .collect();
+        p
+    }
+}
+
+impl<'a> Problem<'a> {
     fn n(&self) -> usize {
         self.sel.len()
+    }
+
+    /// The nodes of `among` whose moments for the weights `vals` miss their targets by more
+    /// than [`TOLERANCE`] (relative to the node's unit).
+    fn missing(&self, vals: &[Real], among: &[bool]) -> Vec<bool> {
+        (0..self.n())
+            .into_par_iter()
+            .map(|i| {
+                among[i]
+                    && (self.raw_moment(vals, i) - self.target[i]).amax() / self.unit[i] > TOLERANCE
+            })
+            .collect()
+    }
+
+    /// The problem on the nodes `active` alone: every pair that touches a node of `full`
+    /// outside `active` is held at K (its K' is zero here and its moments move into the
+    /// targets of the active nodes), so those nodes keep their moments exactly.
+    fn restricted(&self, active: &[bool], full: &[bool]) -> Problem<'a> {
+        let n = self.n();
+        let held = |i: usize| i < n && full[i] && !active[i];
+        let mut k0 = self.k0.clone();
+        let mut target = self.target.clone();
+        for i in 0..n {
+            for e in self.offsets[i]..self.offsets[i + 1] {
+                let j = self.cols[e] as usize;
+                if held(i) || held(j) {
+                    if active[i] {
+                        target[i] -= self.k0[e] * self.phis(i, j).0;
+                    }
+                    k0[e] = 0.0;
+                }
+            }
+        }
+        Problem {
+            cloud: self.cloud,
+            offsets: self.offsets,
+            cols: self.cols,
+            k0,
+            sel: active.to_vec(),
+            used: self.used,
+            target,
+            unit: self.unit.clone(),
+        }
+    }
+
+    /// The nodes of `within` at most `hops` neighbour rings (rows of K) from a node of `seeds`.
+    fn rings(&self, seeds: &[bool], hops: usize, within: &[bool]) -> Vec<bool> {
+        let n = self.n();
+        let mut reached = seeds.to_vec();
+        let mut front: Vec<usize> = (0..n).filter(|&i| seeds[i]).collect();
+        for _ in 0..hops {
+            let mut next = Vec::new();
+            for &i in &front {
+                for e in self.offsets[i]..self.offsets[i + 1] {
+                    let j = self.cols[e] as usize;
+                    if j < n && !reached[j] {
+                        reached[j] = true;
+                        next.push(j);
+                    }
+                }
+            }
+            if next.is_empty() {
+                break;
+            }
+            front = next;
+        }
+        reached.iter().zip(within).map(|(r, w)| *r && *w).collect()
     }
 
     fn lam<'b>(&self, lambda: &'b [Mom], j: usize) -> Option<&'b Mom> {
@@ -452,9 +594,18 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
     (newton, cg)
 }
 
+/// Neighbour rings around the nodes that miss their moments in the first local solve.
+const FIRST_HOPS: usize = 3;
+
 /// Corrects `k` in place so that the body nodes with `sel[i]` meet the moments of `order`
 /// (see the module documentation); `conductivity[i]` is the k_i of node i's target, W/(m·K).
 /// Returns what was achieved and which body nodes now meet their moments.
+///
+/// The solve is local: only the pairs among the nodes that miss their moments and a few
+/// rings of neighbours around them change (on a lattice with a change of horizon, a band
+/// along the change; on a mesh, every node). Every pair that touches a selected node outside
+/// that set keeps K, so those nodes keep their exact moments; where the band is too narrow
+/// for a solution, it grows (twice the rings) and the solve starts again from K.
 pub fn correct(
     k: &mut Conductance,
     cloud: &Cloud,
@@ -462,66 +613,7 @@ pub fn correct(
     conductivity: &[Real],
     order: Order,
 ) -> (Consistency, Vec<bool>) {
-    let n = k.n_rows();
-    let dim = cloud.dim;
-    let quad = order == Order::Quadratic;
-    let mut used = Mom::zeros();
-    for a in 0..dim {
-        used[a] = 1.0;
-    }
-    if quad {
-        for c in [3, 4, 5, 6, 7, 8] {
-            let axes: &[usize] = match c {
-                3 => &[0],
-                4 => &[1],
-                5 => &[2],
-                6 => &[0, 1],
-                7 => &[0, 2],
-                _ => &[1, 2],
-            };
-            if axes.iter().all(|&a| a < dim) {
-                used[c] = 1.0;
-            }
-        }
-    }
-    let target: Vec<Mom> = (0..n)
-        .map(|i| {
-            let mut t = Mom::zeros();
-            if quad {
-                let s = cloud.horizon[i];
-                for a in 0..dim {
-                    t[3 + a] = 2.0 * conductivity[i] * cloud.volume[i] / (s * s);
-                }
-            }
-            t
-        })
-        .collect();
-    let mut p = Problem {
-        cloud,
-        offsets: &k.offsets,
-        cols: &k.cols,
-        k0: k.vals.clone(),
-        sel: sel[..n].to_vec(),
-        used,
-        target,
-        unit: Vec::new(),
-    };
-    // unit of node i: its diagonal target second moment, or (linear) the present one
-    p.unit = (0..n)
-        .map(|i| {
-            let s2 = cloud.horizon[i] * cloud.horizon[i];
-            let present: Real = (k.offsets[i]..k.offsets[i + 1])
-                .map(|e| p.k0[e] * (cloud.pos[k.cols[e] as usize] - cloud.pos[i]).norm_squared())
-                .sum::<Real>()
-                / (s2 * dim as Real);
-            let u = if quad { p.target[i][3] } else { present };
-            if u > 0.0 && p.sel[i] {
-                u
-            } else {
-                Real::INFINITY
-            }
-        })
-        .collect();
+    let mut p = Problem::new(k, cloud, sel, conductivity, order);
     let mut out = Consistency {
         before: p.worst(&p.residual(&p.k0)),
         min_ratio: 1.0,
@@ -534,14 +626,46 @@ pub fn correct(
         summarise(&p, &vals, &[], &mut out);
         return (out, p.sel);
     }
+    let full = p.sel.clone();
+    let seeds = p.missing(&p.k0, &full);
+    let mut hops = FIRST_HOPS;
+    let (vals, left_out) = loop {
+        let active = p.rings(&seeds, hops, &full);
+        let whole = active == full;
+        let mut local = p.restricted(&active, &full);
+        let mut tried = Consistency::default();
+        let (mut vals, left_out) = solve_selection(&mut local, order, &mut tried);
+        out.newton += tried.newton;
+        out.iterations += tried.iterations;
+        if whole || !left_out.contains(&true) {
+            // the pairs held fixed come back
+            for (v, (k0, l)) in vals.iter_mut().zip(p.k0.iter().zip(&local.k0)) {
+                if *l == 0.0 {
+                    *v = *k0;
+                }
+            }
+            break (vals, left_out);
+        }
+        hops *= 2;
+    };
+    for i in 0..full.len() {
+        p.sel[i] = full[i] && !left_out[i];
+    }
+    summarise(&p, &vals, &left_out, &mut out);
+    let sel = p.sel;
+    store(k, vals);
+    (out, sel)
+}
+
+/// The corrected weights for the nodes `p.sel` (the additive form first for the linear order,
+/// else rounds of Newton that leave out nodes without a solution), and the nodes left out.
+fn solve_selection(p: &mut Problem, order: Order, out: &mut Consistency) -> (Vec<Real>, Vec<bool>) {
+    let n = p.n();
     if order == Order::Linear {
-        if let Some((vals, it)) = additive::linear(&p) {
+        if let Some((vals, it)) = additive::linear(p) {
             if p.worst(&p.residual(&vals)) <= TOLERANCE {
-                out.iterations = it;
-                summarise(&p, &vals, &[], &mut out);
-                let sel = p.sel;
-                store(k, vals);
-                return (out, sel);
+                out.iterations += it;
+                return (vals, vec![false; n]);
             }
         }
     }
@@ -549,7 +673,7 @@ pub fn correct(
     let mut vals = p.k0.clone();
     let mut left_out = vec![false; n];
     for round in 0..MAX_ROUNDS {
-        let (nw, cg) = newton(&p, &mut lambda, &mut vals);
+        let (nw, cg) = newton(p, &mut lambda, &mut vals);
         out.newton += nw;
         out.iterations += cg;
         let res = p.residual(&vals);
@@ -574,10 +698,7 @@ pub fn correct(
         }
         lambda.iter_mut().for_each(|l| *l = Mom::zeros());
     }
-    summarise(&p, &vals, &left_out, &mut out);
-    let sel = p.sel;
-    store(k, vals);
-    (out, sel)
+    (vals, left_out)
 }
 
 /// Stores the pair conductances `vals` in `k` with their row sums.
