@@ -372,6 +372,9 @@ pub struct RunSummary {
     /// Implicit runs: solves, factorisations, accepted and rejected steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub implicit: Option<crate::solve::implicit::ImplicitStats>,
+    /// The `[history]` samples: their file and, per point, peaks and differences.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<crate::history::HistorySummary>,
 }
 
 fn peridynamics() -> String {
