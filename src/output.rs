@@ -28,6 +28,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     std::fs::rename(&tmp, path).map_err(io)
 }
 
+/// A time (s) or coordinate (m) as tables, legends and file names show it: plainly (`0.5`,
+/// `0.00005`), or in exponent form below 1e-6 (`2e-13`, where the plain form is a row of
+/// zeros).
+pub fn number_label(t: f64) -> String {
+    if t != 0.0 && t.abs() < 1e-6 {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
 /// Path of the k-th field file (k from 1).
 pub fn field_path(dir: &Path, k: usize) -> PathBuf {
     dir.join(format!("field_{k}.csv"))
@@ -489,7 +500,7 @@ impl RunSummary {
                     .unwrap_or_else(|| "-".into());
                 format!(
                     "| {name} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {probe} | {} | {} | {:.1} |",
-                    c.time,
+                    number_label(c.time),
                     self.nodes,
                     c.max_abs_diff,
                     c.mean_sq_rel_diff,

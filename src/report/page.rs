@@ -7,7 +7,7 @@ use crate::crack::segments_at;
 use crate::error::Result;
 use crate::math::Point;
 use crate::model::crack_cutters;
-use crate::output::{write_atomic, FieldRows, RunSummary};
+use crate::output::{number_label, write_atomic, FieldRows, RunSummary};
 use crate::plot::{
     field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
@@ -70,12 +70,12 @@ pub fn probe_lines(case: &Case, f: &FieldRows, dim: usize) -> Vec<ProbeLine> {
         .map_or((None, None), |r| (r.line_y, r.line_x));
     let mut lines = Vec::new();
     let horizontal = |y: f64| ProbeLine {
-        name: format!("y = {y}"),
+        name: format!("y = {}", number_label(y)),
         along: 0,
         fixed: Some((1, y)),
     };
     let vertical = |x: f64| ProbeLine {
-        name: format!("x = {x}"),
+        name: format!("x = {}", number_label(x)),
         along: 1,
         fixed: Some((0, x)),
     };
@@ -140,7 +140,7 @@ pub fn draw_maps(
             .collect();
         let mut map = FieldMap::new(&f.pos, &f.theta, &f.spacing);
         map.isolines = &fronts;
-        map.title = format!("{name}: temperature at t = {t} s");
+        map.title = format!("{name}: temperature at t = {} s", number_label(*t));
         map.quantity = if fronts.is_empty() {
             "Temperature (°C)".into()
         } else {
@@ -155,7 +155,7 @@ pub fn draw_maps(
         stems.push(stem);
         if cracked {
             let mut map = FieldMap::new(&f.pos, &f.damage, &f.spacing);
-            map.title = format!("{name}: damage at t = {t} s");
+            map.title = format!("{name}: damage at t = {} s", number_label(*t));
             map.quantity = "Damage φ (–)".into();
             map.colour_map = ColourMap::Sequential;
             map.range = Some((0.0, 1.0));
@@ -331,7 +331,7 @@ pub fn write_report(
                 }
                 let pd: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, f.theta[i])).collect();
                 temps.push(
-                    Series::new(format!("PD, t = {t} s"), pd)
+                    Series::new(format!("PD, t = {} s", number_label(*t)), pd)
                         .style(Style::Markers)
                         .colour(k),
                 );
@@ -344,7 +344,7 @@ pub fn write_report(
                             .collect();
                         if !p.is_empty() {
                             temps.push(
-                                Series::new(format!("{name}, t = {t} s"), p)
+                                Series::new(format!("{name}, t = {} s", number_label(*t)), p)
                                     .style(Style::Dashed)
                                     .colour(k),
                             );
@@ -354,14 +354,14 @@ pub fn write_report(
                 if let Some(r) = &f.reference {
                     let rf: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, r[i])).collect();
                     temps.push(
-                        Series::new(format!("{reference_name}, t = {t} s"), rf)
+                        Series::new(format!("{reference_name}, t = {} s", number_label(*t)), rf)
                             .style(Style::Line)
                             .colour(k),
                     );
                     let e: Vec<(f64, f64)> =
                         nodes.iter().map(|&(i, s)| (s, f.theta[i] - r[i])).collect();
                     errors.push(
-                        Series::new(format!("t = {t} s"), e)
+                        Series::new(format!("t = {} s", number_label(*t)), e)
                             .style(Style::LineMarkers)
                             .colour(k),
                     );
@@ -466,7 +466,7 @@ fn metrics(s: &RunSummary) -> Vec<[String; 6]> {
         .iter()
         .map(|c| {
             [
-                c.time.to_string(),
+                number_label(c.time),
                 format!("{:.3e}", c.max_abs_diff),
                 format!("{:.3e}", c.mean_sq_rel_diff),
                 format!("{:.3e}", c.l2_rel_line),
@@ -629,7 +629,7 @@ pub fn write_index(dir: &Path, reports: &[Written]) -> Result<()> {
             .iter()
             .map(|c| {
                 [
-                    c.time.to_string(),
+                    number_label(c.time),
                     format!("{:.3e}", c.max_abs_diff),
                     format!("{:.3e}", c.l2_rel_line),
                     format!("{:.3e}", c.epsilon),
