@@ -1169,6 +1169,131 @@ mod tests {
         assert!(annulus.check().unwrap().contains("outer_radius"));
     }
 
+    /// The laser series meets its data: zero at t = 0, insulated faces (the slope there below
+    /// 1e-5 of the interior's scale θ(0)/l), and its
+    /// heat ∫ρcθ dx equals the absorbed energy s0·l(1 − e^(−L/l))·∫g dt (Simpson over 400
+    /// points of the series against the closed form, 1e-9 relative: the mode n = 0 carries
+    /// all of it, so this checks e_0 and the time integral; the higher modes are checked
+    /// against finite differences in tests/series.rs).
+    #[test]
+    fn laser_series_meets_its_data() {
+        let (l, t0, a, depth) = (2e-8, 100e-15, 1.992, 15.3e-9);
+        let film = Reference::FilmLaserPulse {
+            x0: 0.0,
+            length: l,
+            diffusivity: 1.26e-4,
+            heat_capacity: 2.5e6,
+            fluence: 13.4,
+            reflectivity: 0.93,
+            depth,
+            duration: t0,
+            shape: a,
+        };
+        assert_eq!(film.check(), None);
+        assert_eq!(film.eval(0.0, 0.0, 0.0, 0.0), 0.0);
+        for t in [1e-13, 2e-13, 7e-13] {
+            // second-order one-sided slopes (−3θ0 + 4θ1 − θ2)/2h, h = 1e-4 L: their error
+            // h²θ‴/3 is below 1e-6 of the scale θ(0)/l of the slope inside
+            let h = 1e-4 * l;
+            let scale = film.eval(0.0, 0.0, 0.0, t) / depth;
+            let th = |x: f64| film.eval(x, 0.0, 0.0, t);
+            let low = (-3.0 * th(0.0) + 4.0 * th(h) - th(2.0 * h)) / (2.0 * h);
+            let high = (3.0 * th(l) - 4.0 * th(l - h) + th(l - 2.0 * h)) / (2.0 * h);
+            for slope in [low, high] {
+                assert!(slope.abs() <= 1e-5 * scale, "t {t}: {slope} of {scale}");
+            }
+            let n = 400;
+            let f = |k: usize| film.eval(k as f64 * l / n as f64, 0.0, 0.0, t);
+            let mut sum = f(0) + f(n);
+            for k in 1..n {
+                sum += f(k) * if k % 2 == 1 { 4.0 } else { 2.0 };
+            }
+            let heat = 2.5e6 * sum * l / (3.0 * n as f64);
+            let s0 = 0.94 * 13.4 * (1.0 - 0.93) / (t0 * depth);
+            let exact =
+                s0 * depth * (1.0 - (-l / depth).exp()) * pulse_integral(0.0, 2.0 * t0, t0 / a, t);
+            assert!(
+                (heat / exact - 1.0).abs() < 1e-9,
+                "t {t}: {heat} vs {exact}"
+            );
+        }
+        // the time integral against Simpson's rule of its definition, on both sides of the peak
+        for (mu, t) in [
+            (0.0, 1e-13),
+            (3e13, 1.5e-13),
+            (3e13, 6e-13),
+            (1.99e13, 9e-13),
+        ] {
+            let (peak, tau) = (2e-13, 5.02e-14);
+            let g = |u: f64| (-mu * (t - u)).exp() * (-(u - peak).abs() / tau).exp();
+            let n = 200_000;
+            let h = t / n as f64;
+            let mut sum = g(0.0) + g(t);
+            for k in 1..n {
+                sum += g(k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
+            }
+            let simpson = sum * h / 3.0;
+            let closed = pulse_integral(mu, peak, tau, t);
+            // the kink at the peak costs Simpson O(h²) there: 1e-8 relative
+            assert!(
+                (closed / simpson - 1.0).abs() < 1e-8,
+                "{closed} vs {simpson}"
+            );
+        }
+    }
+
+    /// The split-plate series meets its data: the held edge follows A t e^(−rt), the other
+    /// edges are insulated (one-sided differences, h = 1e-6 m), the initial split is there at
+    /// small t away from the step, and with equal halves it is `bar_pulse_left` plus the
+    /// uniform field times the slab factor.
+    #[test]
+    fn split_series_meets_its_data() {
+        let split = |below: f64, above: f64| Reference::PlatePulseSplit {
+            x0: -5.0,
+            y0: -5.0,
+            length: 10.0,
+            width: 10.0,
+            diffusivity: 1.0,
+            amplitude: 5.0,
+            rate: 2.0,
+            split: 0.0,
+            below,
+            above,
+        };
+        let p = split(0.5, 0.0);
+        let t: f64 = 3.0;
+        let g = 5.0 * t * (-2.0 * t).exp();
+        assert!((p.eval(-5.0, 1.3, 0.0, t) - g).abs() < 1e-9);
+        let h = 1e-6;
+        let dx = (p.eval(5.0, 1.0, 0.0, t) - p.eval(5.0 - h, 1.0, 0.0, t)) / h;
+        let dy0 = (p.eval(1.0, -5.0 + h, 0.0, t) - p.eval(1.0, -5.0, 0.0, t)) / h;
+        let dy1 = (p.eval(1.0, 5.0, 0.0, t) - p.eval(1.0, 5.0 - h, 0.0, t)) / h;
+        assert!(
+            dx.abs() < 1e-5 && dy0.abs() < 1e-5 && dy1.abs() < 1e-5,
+            "{dx} {dy0} {dy1}"
+        );
+        assert!((p.eval(0.0, -2.0, 0.0, 1e-6) - 0.5).abs() < 1e-3);
+        assert!(p.eval(0.0, 2.0, 0.0, 1e-6).abs() < 1e-3);
+        let uniform = split(0.5, 0.5);
+        let bar = Reference::BarPulseLeft {
+            x0: -5.0,
+            length: 10.0,
+            diffusivity: 1.0,
+            amplitude: 5.0,
+            rate: 2.0,
+        };
+        for x in [-4.0, 0.5, 4.9] {
+            let slab = axis_factor(AxisEnds::FixedLow, x + 5.0, 10.0, 1.0, t);
+            let want = bar.eval(x, 0.0, 0.0, t) + 0.5 * slab;
+            assert!((uniform.eval(x, 3.3, 0.0, t) - want).abs() < 1e-12);
+        }
+        let mut bad = split(0.5, 0.0);
+        if let Reference::PlatePulseSplit { split, .. } = &mut bad {
+            *split = 6.0;
+        }
+        assert!(bad.check().unwrap().contains("split"));
+    }
+
     fn water_freezing() -> Reference {
         Reference::NeumannFreezing {
             x0: 0.0,

@@ -493,10 +493,20 @@ pub struct Case {
 }
 
 impl Case {
-    /// The times the run stops at, s: the outputs and the history's samples, increasing.
+    /// The times the run stops at, s: the outputs and the history's samples up to the last
+    /// output, increasing.
     pub fn times(&self) -> Vec<f64> {
+        let last = self.outputs.last().copied().unwrap_or(self.end);
         match &self.history {
-            Some(h) => crate::history::merge(&self.outputs, &h.times),
+            Some(h) => {
+                let samples: Vec<f64> = h
+                    .times
+                    .iter()
+                    .copied()
+                    .filter(|&t| t <= last * (1.0 + 1e-9))
+                    .collect();
+                crate::history::merge(&self.outputs, &samples)
+            }
             None => self.outputs.clone(),
         }
     }
