@@ -4,7 +4,8 @@
 //! fields, summarised in run.json, drawn by the report against time.
 //!
 //! Contract of `history.csv`: a header `time,point,x,y,z,temperature,reference`, then one row
-//! per sample time (t = 0 first) and point; `reference` is empty when the case has no
+//! per sample time and point, the times increasing: t = 0, the multiples of the interval up
+//! to the last output, and the output times; `reference` is empty when the case has no
 //! analytical reference (tables and the FEM are fields at the output times only).
 
 use crate::analytic::Reference;
