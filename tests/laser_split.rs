@@ -102,6 +102,9 @@ fn laser_film_coarse_follows_the_series() {
     assert!(svg.contains("PD at") && svg.contains("series at") && svg.contains("t (ps)"));
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     assert!(md.contains("## History (201 samples"), "{md}");
+    // history.csv is a run's own file: a second run replaces the directory
+    let again = run_case(&case, &run, |_, _| {}).unwrap();
+    assert_eq!(again.history, s.history);
 }
 
 /// §4.5 at Δx = L/100 (10 000 nodes, Euler at 0.95 of the bound): every node within 1 % of
