@@ -134,16 +134,7 @@ fn execute(
     };
     // the steppers stop at the outputs and at the history's samples
     let times = case.times();
-    let mut recorder = case.history.as_ref().map(|h| {
-        let analytic = match reference.as_ref().map(|r| &r.source) {
-            Some(ReferenceSource::Analytic(a)) => Some(a),
-            _ => None,
-        };
-        Recorder::new(h, &model.cloud, analytic)
-    });
-    if let Some(r) = recorder.as_mut() {
-        r.record(0.0, &theta);
-    }
+    let mut recorder = recorder(case, model, reference.as_ref(), &theta);
     let mut on_output =
         |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
             if let Some(r) = recorder.as_mut() {
@@ -253,6 +244,23 @@ fn execute(
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// The recorder of the case's `[history]` (None without one), with the analytical reference
+/// beside it when the case has one, and its first sample, θ0 at t = 0.
+fn recorder<'a>(
+    case: &Case,
+    model: &Model,
+    reference: Option<&'a ReferenceSpec>,
+    theta0: &[f64],
+) -> Option<Recorder<'a>> {
+    let analytic = match reference.map(|r| &r.source) {
+        Some(ReferenceSource::Analytic(a)) => Some(a),
+        _ => None,
+    };
+    let mut r = Recorder::new(case.history.as_ref()?, &model.cloud, analytic);
+    r.record(0.0, theta0);
+    Some(r)
 }
 
 /// The case's reference ready for comparison: a `[reference.fem]` is solved first (by
