@@ -463,10 +463,12 @@ impl Boundary {
                 *r += s;
             }
         } else if let Some(s) = &self.source {
-            for (i, r) in rate.iter_mut().enumerate() {
+            use rayon::prelude::*;
+            // a time-dependent source is evaluated at every node of every step: in parallel
+            rate.par_iter_mut().enumerate().for_each(|(i, r)| {
                 let p = cloud.pos[i];
                 *r += s.eval(p.x, p.y, p.z, t) / capacity[i];
-            }
+            });
         }
     }
 

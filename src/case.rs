@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::fem::run::FemOptions;
 use crate::fem::solve::Scheme;
+use crate::history::{HistoryPlot, HistorySpec};
 use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use crate::material::{BondRule, Material};
 use crate::math::Point;
@@ -77,6 +78,22 @@ pub struct CaseFile {
     /// Classical reference to compare with.
     #[serde(default)]
     pub reference: Option<ReferenceSection>,
+    /// Temperature histories at points.
+    #[serde(default)]
+    pub history: Option<HistorySection>,
+}
+
+/// `[history]` as written: points sampled at a regular interval up to the last output.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HistorySection {
+    /// Points whose nearest body node is recorded, m (one coordinate per dimension each).
+    pub points: Vec<Vec<f64>>,
+    /// Sampling interval, s.
+    pub interval: f64,
+    /// The report's plot: `temperature` (default) or `normalised` (also T / T_max).
+    #[serde(default)]
+    pub plot: Option<String>,
 }
 
 /// `[domain]`.
@@ -384,6 +401,12 @@ pub struct ReferenceSection {
     /// A vertical probe line x = `line_x` for the report's plots (seed 004 §4.3), m.
     #[serde(default)]
     pub line_x: Option<f64>,
+    /// More vertical probe lines x = each value for the report's plots, m.
+    #[serde(default)]
+    pub lines_x: Vec<f64>,
+    /// More horizontal probe lines y = each value for the report's plots, m.
+    #[serde(default)]
+    pub lines_y: Vec<f64>,
     /// Leave the nodes within this distance of a crack tip out of the measures, m.
     #[serde(default)]
     pub exclude_tips: Option<f64>,
@@ -430,6 +453,10 @@ pub struct ReferenceSpec {
     pub line_y: Option<f64>,
     /// Vertical probe line x = line_x of the report, m.
     pub line_x: Option<f64>,
+    /// More vertical probe lines of the report, m.
+    pub lines_x: Vec<f64>,
+    /// More horizontal probe lines of the report, m.
+    pub lines_y: Vec<f64>,
     /// Nodes within this distance of a crack tip are left out of the measures, m (0: none).
     pub exclude_tips: f64,
     /// The point whose nearest body node is reported, m.
@@ -459,11 +486,31 @@ pub struct Case {
     pub outputs: Vec<f64>,
     /// Reference, if any.
     pub reference: Option<ReferenceSpec>,
+    /// Temperature histories, if any.
+    pub history: Option<HistorySpec>,
     /// The model's estimated size, checked against the memory before it is built.
     pub budget: crate::budget::Estimate,
 }
 
 impl Case {
+    /// The times the run stops at, s: the outputs and the history's samples up to the last
+    /// output, increasing.
+    pub fn times(&self) -> Vec<f64> {
+        let last = self.outputs.last().copied().unwrap_or(self.end);
+        match &self.history {
+            Some(h) => {
+                let samples: Vec<f64> = h
+                    .times
+                    .iter()
+                    .copied()
+                    .filter(|&t| t <= last * (1.0 + 1e-9))
+                    .collect();
+                crate::history::merge(&self.outputs, &samples)
+            }
+            None => self.outputs.clone(),
+        }
+    }
+
     /// Reads, parses and validates a case file.
     pub fn load(path: &Path) -> Result<Case> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
@@ -526,6 +573,29 @@ fn reference(
             ));
         }
     }
+    for (key, v) in [
+        ("reference.lines_x", &r.lines_x),
+        ("reference.lines_y", &r.lines_y),
+    ] {
+        if !v.is_empty() && (dim < 2 || v.iter().any(|x| !x.is_finite())) {
+            return Err(case_err(
+                path,
+                key,
+                "must be finite coordinates of a 2D or 3D case",
+            ));
+        }
+        if v.len() > crate::limits::MAX_HISTORY_POINTS {
+            return Err(case_err(
+                path,
+                key,
+                format!(
+                    "at most {} lines, got {}",
+                    crate::limits::MAX_HISTORY_POINTS,
+                    v.len()
+                ),
+            ));
+        }
+    }
     let source = match (r.solution, r.file, r.fem) {
         (Some(s), None, None) => {
             if let Some(m) = s.check() {
@@ -568,11 +638,68 @@ fn reference(
         source,
         line_y: r.line_y,
         line_x: r.line_x,
+        lines_x: r.lines_x,
+        lines_y: r.lines_y,
         exclude_tips: match r.exclude_tips {
             Some(v) => positive(path, "reference.exclude_tips", v)?,
             None => 0.0,
         },
         probe,
+    })
+}
+
+/// Validates `[history]`: at least one point inside the case's dimension, a positive
+/// interval giving at most [`crate::limits::MAX_HISTORY_ROWS`] rows, a known plot.
+fn history(
+    h: HistorySection,
+    path: &Path,
+    dim: usize,
+    outputs: &[f64],
+    integrator: Integrator,
+) -> Result<HistorySpec> {
+    if integrator == Integrator::Steady {
+        return Err(case_err(
+            path,
+            "history",
+            "a steady solve has no history; use a transient integrator",
+        ));
+    }
+    if h.points.is_empty() || h.points.len() > crate::limits::MAX_HISTORY_POINTS {
+        return Err(case_err(
+            path,
+            "history.points",
+            format!(
+                "give 1 to {} points, got {}",
+                crate::limits::MAX_HISTORY_POINTS,
+                h.points.len()
+            ),
+        ));
+    }
+    let mut points = Vec::new();
+    for (k, p) in h.points.iter().enumerate() {
+        let c = coords(path, dim, p, &format!("history.points[{k}]"))?;
+        points.push(Point::new(c[0], c[1], c[2]));
+    }
+    let interval = positive(path, "history.interval", h.interval)?;
+    let last = outputs.last().copied().unwrap_or(interval);
+    let max = crate::limits::MAX_HISTORY_ROWS / points.len() as f64;
+    let times = crate::history::sample_times(interval, last, max)
+        .map_err(|m| case_err(path, "history.interval", m))?;
+    let plot = match h.plot.as_deref() {
+        None | Some("temperature") => HistoryPlot::Temperature,
+        Some("normalised") => HistoryPlot::Normalised,
+        Some(other) => {
+            return Err(case_err(
+                path,
+                "history.plot",
+                format!("`{other}` is not one of temperature, normalised"),
+            ))
+        }
+    };
+    Ok(HistorySpec {
+        points,
+        times,
+        plot,
     })
 }
 
@@ -1504,6 +1631,10 @@ impl CaseFile {
             crack_correction: self.kernel.crack_correction,
             symmetry: self.symmetry,
         };
+        let history = match self.history {
+            Some(h) => Some(history(h, path, dim, &outputs, integrator)?),
+            None => None,
+        };
         let budget = crate::budget::estimate(&spec, &size_keys, integrator.is_implicit())
             .map_err(|e| in_case(path, e))?;
         Ok(Case {
@@ -1518,6 +1649,7 @@ impl CaseFile {
             end,
             outputs,
             reference,
+            history,
         })
     }
 }

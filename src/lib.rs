@@ -19,6 +19,7 @@ pub mod error;
 pub mod expr;
 pub mod fem;
 pub mod gmsh;
+pub mod history;
 pub mod kernel;
 pub mod limits;
 pub mod material;

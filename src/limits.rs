@@ -22,6 +22,14 @@ pub const MAX_STEPS: f64 = 1e8;
 /// 20 000 allows m ≈ 80 in 2D and m ≈ 16 in 3D, beyond any convergence study.
 pub const MAX_NEIGHBOURS: f64 = 2e4;
 
+/// Most `[history]` points, and most extra probe lines (`reference.lines_x`, `lines_y`).
+/// The bundled cases use at most four; each is a search over the body and a report plot.
+pub const MAX_HISTORY_POINTS: usize = 100;
+
+/// Most rows (samples × points) of a `[history]`, held in memory during the run. The bundled
+/// laser case records 201; 10⁶ rows take about 50 MB.
+pub const MAX_HISTORY_ROWS: f64 = 1e6;
+
 /// Bytes of set-up and run memory per node (positions, spacings, volumes, state vectors, the
 /// boundary's tables and the search structures): a conservative round figure, not a
 /// measurement (about fifty f64 per node).

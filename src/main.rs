@@ -386,7 +386,7 @@ fn print_comparisons(summary: &RunSummary) {
     for c in &summary.reference {
         say!(
             "  t = {:<8} max|diff| = {:.4e}  eq45 = {:.4e}  eq13 = {:.4e}  ε(eq27) = {:.4e}  L2rel(V) = {:.4e}",
-            c.time,
+            peritherm::output::number_label(c.time),
             c.max_abs_diff,
             c.mean_sq_rel_diff,
             c.l2_rel_line,

@@ -3,6 +3,7 @@
 //! Contract: for the k-th output time (k from 1), `field_<k>.csv` with the columns
 //! `x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz`, one row per body
 //! node, and the same fields as a VTK unstructured grid `field_<k>.vtu`; and `run.json`.
+//! A case with a `[history]` also writes `history.csv` ([`crate::history`]).
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
@@ -26,6 +27,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let _guard = crate::staging::writing();
     std::fs::write(&tmp, bytes).map_err(io)?;
     std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// A time (s) or coordinate (m) as tables, legends and file names show it: plainly (`0.5`,
+/// `0.00005`), or in exponent form below 1e-6 (`2e-13`, where the plain form is a row of
+/// zeros).
+pub fn number_label(t: f64) -> String {
+    if t != 0.0 && t.abs() < 1e-6 {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
 }
 
 /// Path of the k-th field file (k from 1).
@@ -372,6 +384,9 @@ pub struct RunSummary {
     /// Implicit runs: solves, factorisations, accepted and rejected steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub implicit: Option<crate::solve::implicit::ImplicitStats>,
+    /// The `[history]` samples: their file and, per point, peaks and differences.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<crate::history::HistorySummary>,
 }
 
 fn peridynamics() -> String {
@@ -486,7 +501,7 @@ impl RunSummary {
                     .unwrap_or_else(|| "-".into());
                 format!(
                     "| {name} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {probe} | {} | {} | {:.1} |",
-                    c.time,
+                    number_label(c.time),
                     self.nodes,
                     c.max_abs_diff,
                     c.mean_sq_rel_diff,

@@ -173,7 +173,7 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
                 ),
             });
         }
-        count_steps(0.0, &case.outputs, dt)
+        count_steps(0.0, &case.times(), dt)
     } else {
         0
     };

@@ -4,6 +4,7 @@ use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::crack::tips_at;
 use crate::error::{Error, Result};
 use crate::fem::run_fem;
+use crate::history::{output_index, Recorder};
 use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::output::read_field;
@@ -131,18 +132,29 @@ fn execute(
         );
         Ok(())
     };
+    // the steppers stop at the outputs and at the history's samples
+    let times = case.times();
+    let mut recorder = recorder(case, model, reference.as_ref(), &theta);
+    let mut on_output =
+        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
+            if let Some(r) = recorder.as_mut() {
+                r.record(t, th);
+            }
+            match output_index(&case.outputs, times[k]) {
+                Some(f) => on_output(f, t, th, conductance, e),
+                None => Ok(()),
+            }
+        };
     let linear_output = |k: usize, t: f64, th: &[f64], c: &crate::operator::Conductance| {
         on_output(k, t, th, c, model.energy(th))
     };
     let result = match (enthalpic.as_mut(), implicit.as_mut()) {
-        (Some(stepper), _) => {
-            stepper.run(&mut theta, 0.0, dt, &case.outputs, &mut on_output, |s| {
-                reached(s as f64 * dt);
-                progress(s, total)
-            })
-        }
+        (Some(stepper), _) => stepper.run(&mut theta, 0.0, dt, &times, &mut on_output, |s| {
+            reached(s as f64 * dt);
+            progress(s, total)
+        }),
         (None, Some(stepper)) if case.integrator == Integrator::Steady => {
-            stepper.steady(&mut theta, &case.outputs, linear_output)
+            stepper.steady(&mut theta, &times, linear_output)
         }
         (None, Some(stepper)) if adaptive.is_some() => {
             let adaptive = adaptive.as_ref().expect("adaptive");
@@ -151,7 +163,7 @@ fn execute(
                 &mut theta,
                 0.0,
                 adaptive,
-                &case.outputs,
+                &times,
                 linear_output,
                 // the number of steps is not known: extrapolate it from the time reached
                 |s, t| {
@@ -160,17 +172,15 @@ fn execute(
                 },
             )
         }
-        (None, Some(stepper)) => {
-            stepper.run(&mut theta, 0.0, dt, &case.outputs, linear_output, |s| {
-                reached(s as f64 * dt);
-                progress(s, total)
-            })
-        }
+        (None, Some(stepper)) => stepper.run(&mut theta, 0.0, dt, &times, linear_output, |s| {
+            reached(s as f64 * dt);
+            progress(s, total)
+        }),
         (None, None) => Explicit::new(model, case.integrator).run(
             &mut theta,
             0.0,
             dt,
-            &case.outputs,
+            &times,
             linear_output,
             |s| {
                 reached(s as f64 * dt);
@@ -192,6 +202,10 @@ fn execute(
         }
         other => keyed(case, other),
     })?;
+    let history = match &recorder {
+        Some(r) => Some(r.write(out)?),
+        None => None,
+    };
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
@@ -226,9 +240,27 @@ fn execute(
         consistency: model.correction,
         reference: comparisons,
         implicit: implicit.as_ref().map(|st| st.stats),
+        history,
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// The recorder of the case's `[history]` (None without one), with the analytical reference
+/// beside it when the case has one, and its first sample, θ0 at t = 0.
+fn recorder<'a>(
+    case: &Case,
+    model: &Model,
+    reference: Option<&'a ReferenceSpec>,
+    theta0: &[f64],
+) -> Option<Recorder<'a>> {
+    let analytic = match reference.map(|r| &r.source) {
+        Some(ReferenceSource::Analytic(a)) => Some(a),
+        _ => None,
+    };
+    let mut r = Recorder::new(case.history.as_ref()?, &model.cloud, analytic);
+    r.record(0.0, theta0);
+    Some(r)
 }
 
 /// The case's reference ready for comparison: a `[reference.fem]` is solved first (by

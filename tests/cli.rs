@@ -33,6 +33,15 @@ outputs = [1.0, 2.0]
 /// A phase change for SMALL's material (melting at 500 °C, never reached).
 const PHASE: &str = "[material.steel.phase_change]\ntemperature = 500.0\nlatent_heat = 3e5\nfrozen_conductivity = 40.0\nfrozen_specific_heat = 400.0\n";
 
+/// A `[history]` for SMALL (one point, every 0.1 s).
+const HISTORY: &str = "[history]\npoints = [[0.5, 0.25]]\ninterval = 0.1\nplot = \"temperature\"\n";
+
+/// A `plate_pulse_split` reference for SMALL's rectangle.
+const SPLIT: &str = "[reference.solution]\nkind = \"plate_pulse_split\"\nx0 = 0.0\ny0 = 0.0\nlength = 1.0\nwidth = 0.5\ndiffusivity = 1.5e-5\namplitude = 100.0\nrate = 1.0\nsplit = 0.25\nbelow = 1.0\nabove = 0.0\n";
+
+/// A `film_laser_pulse` reference with a reflectivity above 1.
+const LASER: &str = "[reference.solution]\nkind = \"film_laser_pulse\"\nx0 = 0.0\nlength = 1.0\ndiffusivity = 1.5e-5\nheat_capacity = 3.3e6\nfluence = 13.4\nreflectivity = 1.5\ndepth = 0.1\nduration = 0.1\nshape = 2.0\n";
+
 fn peritherm(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_peritherm"))
         .args(args)
@@ -202,6 +211,52 @@ fn bad_input_fails_with_one_clear_line() {
                 )
                 .replace("thickness = 0.1\n", ""),
             "symmetry",
+        ),
+        (
+            "unknown history plot",
+            format!("{SMALL}{}", HISTORY.replace("temperature", "log")),
+            "history.plot",
+        ),
+        (
+            "history point",
+            format!("{SMALL}{}", HISTORY.replace("[0.5, 0.25]", "[0.5]")),
+            "history.points[0]",
+        ),
+        (
+            "history interval",
+            format!("{SMALL}{}", HISTORY.replace("0.1", "-0.1")),
+            "history.interval",
+        ),
+        (
+            "too many history samples",
+            format!("{SMALL}{}", HISTORY.replace("0.1", "1e-9")),
+            "history.interval",
+        ),
+        (
+            "probe lines",
+            format!("{SMALL}[reference]\nlines_x = [0.5, nan]\n{SPLIT}"),
+            "reference.lines_x",
+        ),
+        (
+            "split outside the plate",
+            format!(
+                "{SMALL}[reference]\n{}",
+                SPLIT.replace("split = 0.25", "split = 0.75")
+            ),
+            "reference.solution",
+        ),
+        (
+            "reflectivity",
+            format!("{SMALL}[reference]\n{LASER}"),
+            "reference.solution",
+        ),
+        (
+            "unknown reference kind",
+            format!(
+                "{SMALL}[reference]\n{}",
+                SPLIT.replace("plate_pulse_split", "plate_split")
+            ),
+            "line",
         ),
     ];
     for (what, text, key) in cases {

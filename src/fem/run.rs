@@ -450,6 +450,7 @@ fn solve(
         consistency: None,
         reference: comparisons,
         implicit: None,
+        history: None,
     };
     summary.write(out)?;
     Ok(summary)

@@ -331,6 +331,8 @@ mod tests {
             }),
             line_y: None,
             line_x: None,
+            lines_x: Vec::new(),
+            lines_y: Vec::new(),
             exclude_tips: 0.0,
             probe: None,
         };
@@ -385,6 +387,8 @@ mod tests {
             }),
             line_y: None,
             line_x: None,
+            lines_x: Vec::new(),
+            lines_y: Vec::new(),
             exclude_tips: 0.0,
             probe: None,
         };

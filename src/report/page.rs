@@ -7,7 +7,7 @@ use crate::crack::segments_at;
 use crate::error::Result;
 use crate::math::Point;
 use crate::model::crack_cutters;
-use crate::output::{write_atomic, FieldRows, RunSummary};
+use crate::output::{number_label, write_atomic, FieldRows, RunSummary};
 use crate::plot::{
     field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
@@ -53,8 +53,9 @@ impl ProbeLine {
     }
 }
 
-/// The case's probe lines: the bar in 1D; in 2D and 3D the reference's `line_y` and
-/// `line_x`, or the horizontal line through the middle of the nodes when it names none.
+/// The case's probe lines: the bar in 1D; in 2D and 3D the reference's `line_y`, `line_x`,
+/// `lines_y` and `lines_x`, or the horizontal line through the middle of the nodes when it
+/// names none.
 pub fn probe_lines(case: &Case, f: &FieldRows, dim: usize) -> Vec<ProbeLine> {
     if dim == 1 {
         return vec![ProbeLine {
@@ -69,20 +70,26 @@ pub fn probe_lines(case: &Case, f: &FieldRows, dim: usize) -> Vec<ProbeLine> {
         .map_or((None, None), |r| (r.line_y, r.line_x));
     let mut lines = Vec::new();
     let horizontal = |y: f64| ProbeLine {
-        name: format!("y = {y}"),
+        name: format!("y = {}", number_label(y)),
         along: 0,
         fixed: Some((1, y)),
+    };
+    let vertical = |x: f64| ProbeLine {
+        name: format!("x = {}", number_label(x)),
+        along: 1,
+        fixed: Some((0, x)),
     };
     if let Some(y) = ly {
         lines.push(horizontal(y));
     }
     if let Some(x) = lx {
-        lines.push(ProbeLine {
-            name: format!("x = {x}"),
-            along: 1,
-            fixed: Some((0, x)),
-        });
+        lines.push(vertical(x));
     }
+    if let Some(r) = &case.reference {
+        lines.extend(r.lines_y.iter().map(|&y| horizontal(y)));
+        lines.extend(r.lines_x.iter().map(|&x| vertical(x)));
+    }
+    lines.dedup();
     if lines.is_empty() {
         // the node row nearest the middle of the body
         let (lo, hi) = f
@@ -133,7 +140,7 @@ pub fn draw_maps(
             .collect();
         let mut map = FieldMap::new(&f.pos, &f.theta, &f.spacing);
         map.isolines = &fronts;
-        map.title = format!("{name}: temperature at t = {t} s");
+        map.title = format!("{name}: temperature at t = {} s", number_label(*t));
         map.quantity = if fronts.is_empty() {
             "Temperature (°C)".into()
         } else {
@@ -148,7 +155,7 @@ pub fn draw_maps(
         stems.push(stem);
         if cracked {
             let mut map = FieldMap::new(&f.pos, &f.damage, &f.spacing);
-            map.title = format!("{name}: damage at t = {t} s");
+            map.title = format!("{name}: damage at t = {} s", number_label(*t));
             map.quantity = "Damage φ (–)".into();
             map.colour_map = ColourMap::Sequential;
             map.range = Some((0.0, 1.0));
@@ -157,6 +164,93 @@ pub fn draw_maps(
             field_map(&stem, &map)?;
             stems.push(stem);
         }
+    }
+    Ok(stems)
+}
+
+/// A time unit that reads well for times up to `end`, s: its name and seconds per unit.
+fn time_unit(end: f64) -> (&'static str, f64) {
+    [("ps", 1e-12), ("ns", 1e-9), ("µs", 1e-6), ("ms", 1e-3)]
+        .into_iter()
+        .find(|(_, u)| end <= 1e3 * u)
+        .unwrap_or(("s", 1.0))
+}
+
+/// Draws the history of the run in `run` into `dir`: `history` (temperature against time at
+/// every `[history]` point, PD as markers, the reference as lines) and, when the case asks
+/// for `plot = "normalised"`, `history_normalised` (each curve over its own largest |θ|,
+/// T / T_max). Returns the stems drawn.
+pub fn draw_history(
+    case: &Case,
+    summary: &RunSummary,
+    run: &Path,
+    dir: &Path,
+    reference_name: &str,
+) -> Result<Vec<PathBuf>> {
+    let curves = crate::history::read(run)?;
+    let end = curves
+        .iter()
+        .flat_map(|c| c.1.iter().map(|p| p.0))
+        .fold(0.0, f64::max);
+    let (unit, per) = time_unit(end);
+    let normalised = case
+        .history
+        .as_ref()
+        .is_some_and(|h| h.plot == crate::history::HistoryPlot::Normalised);
+    let mut stems = Vec::new();
+    for norm in [false, true] {
+        if norm && !normalised {
+            continue;
+        }
+        let scale = |v: &[(f64, f64)]| {
+            let m = v.iter().fold(0.0f64, |m, p| m.max(p.1.abs()));
+            if norm && m > 0.0 {
+                m
+            } else {
+                1.0
+            }
+        };
+        let mut series = Vec::new();
+        for (k, (p, pd, reference)) in curves.iter().enumerate() {
+            let at = format!("({:.3e}, {:.3e}) m", p.x, p.y);
+            let s = scale(pd);
+            let pts = pd.iter().map(|q| (q.0 / per, q.1 / s)).collect();
+            series.push(
+                Series::new(format!("PD at {at}"), pts)
+                    .style(Style::Markers)
+                    .colour(k),
+            );
+            if let Some(r) = reference {
+                let s = scale(r);
+                let pts = r.iter().map(|q| (q.0 / per, q.1 / s)).collect();
+                series.push(
+                    Series::new(format!("{reference_name} at {at}"), pts)
+                        .style(Style::Line)
+                        .colour(k),
+                );
+            }
+        }
+        let (stem, what, y) = if norm {
+            (
+                "history_normalised",
+                "normalised temperature",
+                "T / T_max (–)",
+            )
+        } else {
+            ("history", "temperature", "Temperature (°C)")
+        };
+        let stem = dir.join(stem);
+        line_plot(
+            &stem,
+            &Labels::new(
+                format!("{}: {what} against time", title(summary)),
+                format!("t ({unit})"),
+                y,
+            ),
+            &series,
+            Legend::LowerRight,
+        )?;
+        stems.push(stem);
     }
     Ok(stems)
 }
@@ -237,7 +331,7 @@ pub fn write_report(
                 }
                 let pd: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, f.theta[i])).collect();
                 temps.push(
-                    Series::new(format!("PD, t = {t} s"), pd)
+                    Series::new(format!("PD, t = {} s", number_label(*t)), pd)
                         .style(Style::Markers)
                         .colour(k),
                 );
@@ -250,7 +344,7 @@ pub fn write_report(
                             .collect();
                         if !p.is_empty() {
                             temps.push(
-                                Series::new(format!("{name}, t = {t} s"), p)
+                                Series::new(format!("{name}, t = {} s", number_label(*t)), p)
                                     .style(Style::Dashed)
                                     .colour(k),
                             );
@@ -260,14 +354,14 @@ pub fn write_report(
                 if let Some(r) = &f.reference {
                     let rf: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, r[i])).collect();
                     temps.push(
-                        Series::new(format!("{reference_name}, t = {t} s"), rf)
+                        Series::new(format!("{reference_name}, t = {} s", number_label(*t)), rf)
                             .style(Style::Line)
                             .colour(k),
                     );
                     let e: Vec<(f64, f64)> =
                         nodes.iter().map(|&(i, s)| (s, f.theta[i] - r[i])).collect();
                     errors.push(
-                        Series::new(format!("t = {t} s"), e)
+                        Series::new(format!("t = {} s", number_label(*t)), e)
                             .style(Style::LineMarkers)
                             .colour(k),
                     );
@@ -302,6 +396,11 @@ pub fn write_report(
                 )?;
                 plots.push(stem_name(&stem));
             }
+        }
+    }
+    if summary.history.is_some() {
+        for stem in draw_history(case, &summary, run, dir, reference_name)? {
+            plots.push(stem_name(&stem));
         }
     }
     if dim == 2 {
@@ -367,7 +466,7 @@ fn metrics(s: &RunSummary) -> Vec<[String; 6]> {
         .iter()
         .map(|c| {
             [
-                c.time.to_string(),
+                number_label(c.time),
                 format!("{:.3e}", c.max_abs_diff),
                 format!("{:.3e}", c.mean_sq_rel_diff),
                 format!("{:.3e}", c.l2_rel_line),
@@ -442,6 +541,11 @@ fn page(w: &Written, case: &Case, run: &Path, reference_name: &str) -> (String, 
         md.push_str("\nThe case has no reference.\n");
         html.push_str("<p>The case has no reference.</p>\n");
     }
+    if let Some(h) = &s.history {
+        let (md_h, html_h) = history_table(h, reference_name);
+        md.push_str(&md_h);
+        html.push_str(&html_h);
+    }
     md.push_str("\n## Plots\n\n");
     html.push_str("<h2>Plots</h2>\n");
     for p in &w.plots {
@@ -453,6 +557,56 @@ fn page(w: &Written, case: &Case, run: &Path, reference_name: &str) -> (String, 
         );
     }
     html.push_str("</body></html>\n");
+    (md, html)
+}
+
+/// The Markdown and HTML of the history's summary: per point, the node, the PD and reference
+/// peaks, and the largest differences of the curves and of the normalised curves.
+fn history_table(h: &crate::history::HistorySummary, reference_name: &str) -> (String, String) {
+    const HEADER: [&str; 6] = [
+        "node (m)",
+        "PD peak (°C)",
+        "at t (s)",
+        "reference peak (°C)",
+        "max abs diff (°C)",
+        "max abs diff of T / T_max",
+    ];
+    let opt = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map(f).unwrap_or_else(|| "-".into());
+    let mut md = format!(
+        "\n## History ({} samples per point, `{}`; reference: {reference_name})\n\n| {} |\n|{}\n",
+        h.samples,
+        h.file,
+        HEADER.join(" | "),
+        "---|".repeat(6)
+    );
+    let mut html = format!(
+        "<h2>History ({} samples per point; reference: {})</h2>\n<table><tr>{}</tr>\n",
+        h.samples,
+        escape(reference_name),
+        HEADER
+            .iter()
+            .map(|c| format!("<th>{}</th>", escape(c)))
+            .collect::<String>()
+    );
+    for p in &h.points {
+        let row = [
+            format!("({:.4e}, {:.4e}, {:.4e})", p.node[0], p.node[1], p.node[2]),
+            format!("{:.5}", p.peak),
+            format!("{:.4e}", p.peak_time),
+            opt(p.reference_peak, &|v| format!("{v:.5}")),
+            opt(p.max_abs_diff, &|v| format!("{v:.3e}")),
+            opt(p.max_abs_diff_normalised, &|v| format!("{v:.3e}")),
+        ];
+        let _ = writeln!(md, "| {} |", row.join(" | "));
+        let _ = writeln!(
+            html,
+            "<tr>{}</tr>",
+            row.iter()
+                .map(|c| format!("<td>{}</td>", escape(c)))
+                .collect::<String>()
+        );
+    }
+    html.push_str("</table>\n");
     (md, html)
 }
 
@@ -475,7 +629,7 @@ pub fn write_index(dir: &Path, reports: &[Written]) -> Result<()> {
             .iter()
             .map(|c| {
                 [
-                    c.time.to_string(),
+                    number_label(c.time),
                     format!("{:.3e}", c.max_abs_diff),
                     format!("{:.3e}", c.l2_rel_line),
                     format!("{:.3e}", c.epsilon),
