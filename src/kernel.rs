@@ -8,6 +8,10 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Relative round-off below which a partial-volume factor β counts as zero (see
+/// [`Kernel::coverage`]).
+pub const ROUNDOFF: f64 = 1e-9;
+
 /// Shape w(r/δ) of the micro-conductivity inside the horizon.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -120,14 +124,17 @@ impl Kernel {
     }
 
     /// Partial-volume factor β of a neighbour at distance `r` with spacing `dj`
-    /// inside the horizon `delta`, and the distance at which w is evaluated.
+    /// inside the horizon `delta`, and the distance at which w is evaluated. A neighbour
+    /// whose β would be below [`ROUNDOFF`] is outside (β = 0): such a β is the round-off of
+    /// coordinates (a gmsh node one bit from the lattice's), and it would decide which pairs
+    /// exist.
     pub fn coverage(&self, r: f64, delta: f64, dj: f64) -> (f64, f64) {
         match self.partial_volume {
             PartialVolume::AllOrNothing => (if r <= delta { 1.0 } else { 0.0 }, r),
             PartialVolume::Algorithm1 => {
                 if r <= delta - 0.5 * dj {
                     (1.0, r)
-                } else if r <= delta + 0.5 * dj {
+                } else if r <= delta + 0.5 * dj * (1.0 - 2.0 * ROUNDOFF) {
                     let beta = (delta + 0.5 * dj - r) / dj;
                     let at = match self.profile {
                         Profile::Constant => r,
@@ -292,5 +299,8 @@ mod tests {
         let (b, at) = k.coverage(1.05, 1.0, 0.2);
         assert!((b - 0.25).abs() < 1e-12 && (at - (1.0 - 0.2 * 0.25 / 2.0)).abs() < 1e-12);
         assert_eq!(k.coverage(1.2, 1.0, 0.2).0, 0.0);
+        // a neighbour one round-off inside the outer edge is outside, one ten times further in is not
+        assert_eq!(k.coverage(1.1 - 1e-12, 1.0, 0.2).0, 0.0);
+        assert!(k.coverage(1.1 - 1e-8, 1.0, 0.2).0 > 0.0);
     }
 }
