@@ -490,6 +490,10 @@ pub struct Case {
     pub history: Option<HistorySpec>,
     /// The model's estimated size, checked against the memory before it is built.
     pub budget: crate::budget::Estimate,
+    /// The case file's text as read (a run writes it into its directory as `case.toml`).
+    pub source: String,
+    /// The other files the case reads (mesh, reference table, FEM mesh), resolved.
+    pub inputs: Vec<PathBuf>,
 }
 
 impl Case {
@@ -535,7 +539,11 @@ impl Case {
                 message: msg.trim().to_string(),
             }
         })?;
-        file.validate(path)
+        let inputs = file.inputs(path);
+        let mut case = file.validate(path)?;
+        case.source = text.to_string();
+        case.inputs = inputs;
+        Ok(case)
     }
 }
 
@@ -1650,6 +1658,24 @@ impl CaseFile {
             outputs,
             reference,
             history,
+            source: String::new(),
+            inputs: Vec::new(),
         })
+    }
+
+    /// The files besides itself that the case at `path` reads, resolved against its folder.
+    fn inputs(&self, path: &Path) -> Vec<PathBuf> {
+        let base = path.parent().unwrap_or(Path::new("."));
+        let reference = self.reference.as_ref();
+        let table = reference.and_then(|r| r.file.as_ref());
+        let fem_mesh = reference
+            .and_then(|r| r.fem.as_ref())
+            .and_then(|f| f.mesh.as_ref());
+        let mesh = self.mesh.as_ref().map(|m| &m.file);
+        [mesh, table, fem_mesh]
+            .into_iter()
+            .flatten()
+            .map(|f| base.join(f))
+            .collect()
     }
 }

@@ -31,6 +31,7 @@ pub mod operator;
 pub mod output;
 pub mod plot;
 pub mod prepare;
+pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod run;

@@ -409,7 +409,7 @@ fn compare(
     }
     let a = RunSummary::read(run)?;
     let b = RunSummary::read(reference)?;
-    let case = Case::load(std::path::Path::new(&a.case))?;
+    let case = peritherm::provenance::case_of_run(run, &a)?;
     let cloud = case
         .spec
         .geometry
@@ -583,7 +583,7 @@ fn sweep(
 /// with damage, a damage map; PNG and SVG.
 fn plot(run: &std::path::Path) -> anyhow::Result<()> {
     let summary = RunSummary::read(run)?;
-    let case = Case::load(std::path::Path::new(&summary.case))?;
+    let case = peritherm::provenance::case_of_run(run, &summary)?;
     if case.spec.geometry.bare_cloud()?.dim != 2 {
         anyhow::bail!(
             "{}: maps are drawn for 2D runs; open the field_<k>.vtu files in ParaView",

@@ -328,6 +328,26 @@ pub struct Probe {
     pub classical: f64,
 }
 
+/// A file's identity when a run read it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileStamp {
+    /// Absolute path.
+    pub path: String,
+    /// Size, bytes.
+    pub bytes: u64,
+    /// FNV-1a 64-bit hash of the contents, hexadecimal.
+    pub fnv1a: String,
+}
+
+/// The case of a run: where its file was and the files it read.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CaseOrigin {
+    /// Absolute path of the case file (the copy's relative paths resolve against its folder).
+    pub path: String,
+    /// The other files the case read, stamped.
+    pub inputs: Vec<FileStamp>,
+}
+
 /// Summary written to run.json.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunSummary {
@@ -387,6 +407,9 @@ pub struct RunSummary {
     /// The `[history]` samples: their file and, per point, peaks and differences.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<crate::history::HistorySummary>,
+    /// Where the case came from ([`crate::provenance`]); absent in runs written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<CaseOrigin>,
 }
 
 fn peridynamics() -> String {

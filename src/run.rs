@@ -206,6 +206,7 @@ fn execute(
         Some(r) => Some(r.write(out)?),
         None => None,
     };
+    let origin = crate::provenance::write_copy(out, case)?;
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
@@ -241,6 +242,7 @@ fn execute(
         reference: comparisons,
         implicit: implicit.as_ref().map(|st| st.stats),
         history,
+        origin: Some(origin),
     };
     summary.write(out)?;
     Ok(summary)

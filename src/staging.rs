@@ -58,6 +58,7 @@ pub struct Unfinished {
 /// Names an output directory may hold and still be replaced: a run's own files.
 fn is_ours(name: &str) -> bool {
     name == "run.json"
+        || name == crate::provenance::CASE_COPY
         || name == crate::history::FILE
         || name == "fem"
         || name.starts_with('.')

@@ -541,3 +541,47 @@ initial = 40.0
     assert!(!o.status.success());
     assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
 }
+
+/// A run's directory stands on its own: run from the case's folder with relative paths (the
+/// case's mesh path relative too), `compare` and `plot` started from another directory read
+/// the run's `case.toml` copy and work; once the mesh file changes they refuse with one line
+/// naming it.
+#[test]
+fn compare_and_plot_work_from_any_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let work = dir.path().join("work");
+    std::fs::create_dir_all(work.join("meshes")).unwrap();
+    std::fs::copy(root.join("meshes/l_shape.msh"), work.join("meshes/l.msh")).unwrap();
+    let text = "dimension = 2\n[mesh]\nfile = \"meshes/l.msh\"\n[[region]]\nname = \"plate\"\nhorizon = { factor = 3 }\n[material.m]\nconductivity = 1.0\ndensity = 1.0\nspecific_heat = 1.0\n[boundary.left]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 10.0\n[time]\nend = 1e-6\noutputs = [1e-6]\n";
+    write_case(&work, "l.toml", text);
+    let run = |cwd: &Path, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_peritherm"))
+            .current_dir(cwd)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&work, &["run", "l.toml", "--out", "out", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read_to_string(work.join("out/case.toml")).unwrap(),
+        text,
+        "the run keeps the case's text"
+    );
+    let elsewhere = dir.path();
+    let o = run(elsewhere, &["compare", "work/out", "work/out"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(elsewhere, &["plot", "work/out"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(work.join("out/map_1.png").exists());
+
+    let mut bytes = std::fs::read(work.join("meshes/l.msh")).unwrap();
+    bytes.extend_from_slice(b"\n");
+    std::fs::write(work.join("meshes/l.msh"), bytes).unwrap();
+    let o = run(elsewhere, &["plot", "work/out"]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("l.msh") && err.contains("changed"), "{err}");
+}

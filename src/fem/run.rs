@@ -422,6 +422,7 @@ fn solve(
         )?;
         fields.push(format!("field_{}.csv", k + 1));
     }
+    let origin = crate::provenance::write_copy(out, case)?;
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
@@ -451,6 +452,7 @@ fn solve(
         reference: comparisons,
         implicit: None,
         history: None,
+        origin: Some(origin),
     };
     summary.write(out)?;
     Ok(summary)
