@@ -238,9 +238,10 @@ pub struct KernelSpec {
     pub crack_correction: bool,
 }
 
-/// On a mesh, every boundary set that no `[boundary]` names (and the facets in no group) is
-/// insulated through a mirrored layer: the surface correction of the free-surface skin effect
-/// (formulation §3). `type = "free"` keeps the uncorrected surface; crack groups stay as they are.
+/// On a mesh, every boundary set that no `[boundary]` names (and the facets in no group,
+/// unless `[boundary."(no group)"]` names them) is insulated through a mirrored layer: the
+/// surface correction of the free-surface skin effect (formulation §3). `type = "free"` keeps
+/// the uncorrected surface; crack groups stay as they are.
 fn unnamed_insulated(
     faces: &mut [FaceBc],
     geometry: &MeshGeometry,
@@ -256,7 +257,10 @@ fn unnamed_insulated(
         })
         .collect();
     for (s, face) in faces.iter_mut().enumerate() {
-        let given = names.get(s).is_some_and(|n| named.contains_key(n));
+        let name = names
+            .get(s)
+            .map_or(crate::cloud::mesh::UNNAMED, String::as_str);
+        let given = named.contains_key(name);
         if !given && !cracked.contains(&s) {
             *face = FaceBc::LayerInsulated;
         }
@@ -1398,7 +1402,9 @@ impl CaseFile {
         };
         for (name, b) in &self.boundary {
             let key = |k: &str| format!("boundary.{name}.{k}");
-            let f = set_names.iter().position(|n| n == name).ok_or_else(|| {
+            // on a mesh, `[boundary."(no group)"]` names the facets in no group
+            let unnamed = (mesh && name == crate::cloud::mesh::UNNAMED).then_some(set_names.len());
+            let f = set_names.iter().position(|n| n == name).or(unnamed).ok_or_else(|| {
                 let what = match &geometry {
                     Geometry::Box(_) if FACE_NAMES.contains(&name.as_str()) => {
                         format!("a {dim}D case has faces {set_names:?}")
@@ -1412,7 +1418,7 @@ impl CaseFile {
                 err(&format!("boundary.{name}"), what)
             })?;
             if let Geometry::Mesh(g) = &geometry {
-                if g.set_is_empty(f) {
+                if unnamed.is_none() && g.set_is_empty(f) {
                     return Err(err(
                         &format!("boundary.{name}"),
                         "the mesh's physical group of this name has no elements".into(),

@@ -7,7 +7,7 @@ use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::weights::Order;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const MESHES: [(&str, usize); 5] = [
     ("moments_tri.msh", 2),
@@ -17,8 +17,29 @@ const MESHES: [(&str, usize); 5] = [
     ("moments_tet.msh", 3),
 ];
 
-/// A case on `file` with conductivity 2, the wall given `wall` (a TOML table body).
+/// The lowest level of each family of the mesh-convergence suite (boundary group `held`).
+const SUITE: [(&str, usize); 5] = [
+    ("conv_rect_tri_L1.msh", 2),
+    ("conv_rect_quad_L1.msh", 2),
+    ("conv_graded_L1.msh", 2),
+    ("conv_disc_L1.msh", 2),
+    ("conv_cube_tet_L1.msh", 3),
+];
+
+/// A case on `file` with conductivity 2, the group `wall` given `wall` (a TOML table body).
 fn model(file: &str, dim: usize, wall: &str, initial: &str, order: Option<&str>) -> Model {
+    model_on(file, dim, ("wall", wall), initial, order)
+}
+
+/// [`model`] with the boundary group named `group.0`.
+fn model_on(
+    file: &str,
+    dim: usize,
+    group: (&str, &str),
+    initial: &str,
+    order: Option<&str>,
+) -> Model {
+    let (name, wall) = group;
     let consistency = order.map_or(String::new(), |o| format!("consistency = \"{o}\"\n"));
     let text = format!(
         r#"
@@ -34,7 +55,7 @@ density = 1.0
 specific_heat = 1.0
 [kernel]
 {consistency}
-[boundary.wall]
+[boundary.{name}]
 {wall}
 [initial]
 value = "{initial}"
@@ -106,19 +127,29 @@ fn quadratic_fields_are_integrated_exactly_on_every_mesh_kind() {
 /// With free walls (no fictitious nodes) the corrected K is symmetric bit for bit with every
 /// entry positive, an Euler run at 0.99 of the stable bound stays bounded by the initial
 /// maximum for 10⁴ steps (positive weights: each step is a convex combination), and the
-/// energy is conserved to 1e-12 relative.
+/// energy is conserved to 1e-12 relative: on every mesh kind and on the suite's families.
 #[test]
 fn consistent_weights_are_symmetric_positive_stable_and_conservative() {
-    for (file, dim) in MESHES {
-        let m = model(
+    // the suite's meshes leave facets in no group (insulated by default): free them too
+    let free = "type = \"free\"";
+    let free_all = "type = \"free\"\n[boundary.\"(no group)\"]\ntype = \"free\"";
+    let kinds = MESHES.iter().map(|&(f, d)| (f, d, "wall", free));
+    for (file, dim, group, wall) in
+        kinds.chain(SUITE.iter().map(|&(f, d)| (f, d, "held", free_all)))
+    {
+        let m = model_on(
             file,
             dim,
-            "type = \"free\"",
+            (group, wall),
             "2 + sin(40*x)*cos(37*y) + z",
             None,
         );
         let c = m.correction.unwrap();
-        assert!(c.corrected > 0, "{file}: {c:?}");
+        // every node of the coarsest cube lies within δ of a (free) face: nothing to correct,
+        // the kernel's own weights are checked there
+        let coarse_cube = file == "conv_cube_tet_L1.msh";
+        assert!(c.corrected > 0 || coarse_cube, "{file}: {c:?}");
+        assert_eq!(m.cloud.n_fictitious(), 0, "{file}");
         let k = &m.conductance;
         for i in 0..k.n_rows() {
             for b in k.offsets[i]..k.offsets[i + 1] {
@@ -165,9 +196,11 @@ fn the_linear_order_leaves_second_moments_alone() {
 }
 
 /// Extruded hexahedra (moments_hex.msh, 6 layers): OPEN. The correction meets the moments at
-/// 414 of 594 nodes and leaves 180 with no positive symmetric solution found; the mesh is not
-/// refused, and the nodes left out are counted with how far from exact they stay. This test
-/// pins that report (it fails, and should be tightened, once the hexahedra are corrected).
+/// 523 of 594 nodes and leaves 71 out; a linear program over the same pairs (nonnegative,
+/// symmetric K) has no solution there at all: layers 0.1 apart against horizons of
+/// 0.26–0.29 leave too few pairs in z. The mesh is not refused, and the nodes left out are
+/// counted with how far from exact they stay. This test pins that report (it fails, and
+/// should be tightened, once the hexahedra are corrected).
 #[test]
 fn hexahedra_left_out_nodes_are_reported_not_refused() {
     let m = model("moments_hex.msh", 3, "type = \"insulated\"", "0", None);
@@ -177,4 +210,77 @@ fn hexahedra_left_out_nodes_are_reported_not_refused() {
     assert!(c.after < 1e-10 && c.min_ratio > 0.0, "{c:?}");
     let met = m.consistent.iter().filter(|&&x| x).count();
     assert_eq!(met, c.corrected);
+}
+
+/// Every body group of `file` (under meshes/) as a region with δ = 3Δ, one material, every
+/// boundary facet free (no group named), the default kernel: the consistent weights are on.
+fn default_model(file: &Path) -> Result<Model, String> {
+    let mesh = peritherm::gmsh::read(file).map_err(|e| e.to_string())?;
+    let dim = mesh.dim();
+    let mut text = format!("dimension = {dim}\n[mesh]\nfile = \"{}\"\n", file.display());
+    for g in mesh.groups.iter().filter(|g| g.dim == dim) {
+        text += &format!(
+            "[[region]]\nname = \"{}\"\nhorizon = {{ factor = 3 }}\n",
+            g.name
+        );
+    }
+    text += "[material.m]\nconductivity = 1.0\ndensity = 1.0\nspecific_heat = 1.0\n";
+    text += "[initial]\nvalue = 1.0\n[time]\nend = 1.0\n";
+    let case = Case::parse(&text, Path::new("every_mesh.toml")).map_err(|e| e.to_string())?;
+    Model::build(&case.spec).map_err(|e| e.to_string())
+}
+
+/// The committed meshes of meshes/ with at most `max_bytes` bytes (all: usize::MAX).
+fn committed_meshes(max_bytes: u64) -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("meshes");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "msh"))
+        .filter(|p| std::fs::metadata(p).unwrap().len() <= max_bytes)
+        .collect();
+    files.sort();
+    files
+}
+
+/// Builds every mesh in `files` with the default settings; none may be refused, and every
+/// node the correction leaves out is counted (corrected + left out = body nodes).
+fn assert_none_refused(files: &[PathBuf]) {
+    assert!(!files.is_empty());
+    for f in files {
+        let m = default_model(f).unwrap_or_else(|e| panic!("{}: refused: {e}", f.display()));
+        let c = m.correction.expect("mesh cases are corrected by default");
+        assert!(
+            c.corrected + c.uncorrected <= m.cloud.n_body,
+            "{}: {c:?}",
+            f.display()
+        );
+        eprintln!(
+            "{}: {} nodes, {} corrected, {} left out (worst {:.2e}), K ratios {:.1e}..{:.1e}",
+            f.file_name().unwrap().to_string_lossy(),
+            m.cloud.n_body,
+            c.corrected,
+            c.uncorrected,
+            c.worst_uncorrected,
+            c.min_ratio,
+            c.max_ratio
+        );
+    }
+}
+
+/// No mesh of meshes/ up to 80 kB (11 of 37, each below 2 000 nodes) is refused with the
+/// default settings and every facet free. The larger ones are built by the bundled cases and
+/// the convergence tests, and all of them by the ignored test below.
+#[test]
+fn no_committed_mesh_is_refused() {
+    assert_none_refused(&committed_meshes(80_000));
+}
+
+/// The same for every mesh of meshes/, the largest levels of the convergence suite included
+/// (the 26 meshes up to 1 MB took 7.5 minutes on 2 cores under load 7; the four 4.5–12.5 MB
+/// level-4 meshes take longer: `cargo test --release --test weights -- --ignored`).
+#[test]
+#[ignore]
+fn no_committed_mesh_is_refused_large_ones_included() {
+    assert_none_refused(&committed_meshes(u64::MAX));
 }
