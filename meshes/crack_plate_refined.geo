@@ -1,7 +1,7 @@
 // dim: 2
-// Seed 003 Example 3 with a refined zone: square plate [-0.01, 0.01]² (units: metres, z = 0)
-// with a crack from (-0.005, 0) to (0.005, 0), a curve embedded in the surface so that mesh
-// edges follow it. The zone |x| <= 0.0065, |y| <= 0.0015 (crack, tips and 1.5 mm around
+// Bobaru & Duangpanya 2012 Example 3 with a refined zone: square plate [-0.01, 0.01]² (units:
+// metres, z = 0) with a crack from (-0.005, 0) to (0.005, 0), a curve embedded in the surface so
+// that mesh edges follow it. The zone |x| <= 0.0065, |y| <= 0.0015 (crack, tips and 1.5 mm around
 // them) has triangles of size h = 1.25e-4 m, meshed exactly as in crack_plate_uniform.geo;
 // the far field grows linearly over a 2 mm band to 4.5 h (Box field with Thickness).
 SetFactory("Built-in");

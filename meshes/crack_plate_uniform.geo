@@ -1,7 +1,7 @@
 // dim: 2
-// Seed 003 Example 3, uniform fine: square plate [-0.01, 0.01]² (units: metres, z = 0) with a
-// crack from (-0.005, 0) to (0.005, 0), a curve embedded in the surface so that mesh edges
-// follow it. Triangles of size h = 1.25e-4 m everywhere. Two surfaces: the zone
+// Bobaru & Duangpanya 2012 Example 3, uniform fine: square plate [-0.01, 0.01]² (units: metres, z =
+// 0) with a crack from (-0.005, 0) to (0.005, 0), a curve embedded in the surface so that mesh
+// edges follow it. Triangles of size h = 1.25e-4 m everywhere. Two surfaces: the zone
 // |x| <= 0.0065, |y| <= 0.0015 around the crack, meshed exactly as in crack_plate_refined.geo,
 // and the far field.
 SetFactory("Built-in");

@@ -1,5 +1,5 @@
 // dim: 2
-// Seed 004 §4.1 two-region plate, mesh ratio k = Δ1/Δ2 = 1 (units: metres, z = 0).
+// Wang, Oterkus & Oterkus §4.1 two-region plate, mesh ratio k = Δ1/Δ2 = 1 (units: metres, z = 0).
 // Square [-0.005, 0.005]² made of two SEPARATE rectangles that share no point or curve:
 // the interface x = 0 is two coincident, distinct curves (no Coherence), in no physical group.
 // Structured quadrilaterals: Region 1 (x < 0) spacing 1e-4 m (50 × 100 cells),

@@ -1,7 +1,8 @@
 // dim: 2
-// Seed 001 §3.4 (Fig. 8): the (r, z) section of a thick pipe heated on part of its outer
-// surface, for the Fig. 11 study (Δ = 0.01 m). Units: metres; x = r, y = z (z = 0 plane of the file).
-// The square r ∈ [0.4, 1.2] × z ∈ [0, 0.8] (0.8 × 0.8 m as in the paper; the inner radius
+// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.4 (Fig. 8): the (r, z)
+// section of a thick pipe heated on part of its outer surface, for the Fig. 11 study (Δ = 0.01 m).
+// Units: metres; x = r, y = z (z = 0 plane of the file). The square r ∈ [0.4, 1.2] × z ∈ [0, 0.8]
+// (0.8 × 0.8 m as in the paper; the inner radius
 // 0.4 m is our choice: the paper does not give it, and mirrored layers one horizon thick at
 // the inner surface must stay at r > 0 for the largest horizon of the study, δ = 8 × 0.04 m).
 // The heated part of the outer surface r = 1.2 is z ∈ [0.32, 0.52] (L = 0.2 m as in Fig. 8;

@@ -1,9 +1,9 @@
 // dim: 2
-// Seed 001 §3.4: the FEM reference mesh of cases/pipe_heating_2d.toml and of the Fig. 11
-// study (scripts/pipe-heating-study.sh): the same (r, z) section and physical groups as
-// pipe_heating_d*.geo (r ∈ [0.4, 1.2] m, z ∈ [0, 0.8] m, heated band r = 1.2 m,
-// z ∈ [0.32, 0.52] m), in triangles graded towards the two ends of the heated band.
-// Why graded: where the held band meets the insulated surface the temperature goes as
+// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.4: the FEM reference mesh
+// of cases/pipe_heating_2d.toml and of the Fig. 11 study (scripts/pipe-heating-study.sh): the same
+// (r, z) section and physical groups as pipe_heating_d*.geo (r ∈ [0.4, 1.2] m, z ∈ [0, 0.8] m,
+// heated band r = 1.2 m, z ∈ [0.32, 0.52] m), in triangles graded towards the two ends of the
+// heated band. Why graded: where the held band meets the insulated surface the temperature goes as
 // s^½ (s the distance to the end), and on uniform elements the FEM converges at first order
 // only (measured: ε of quads of 0.04, 0.02, 0.01 m against this mesh's solution 4.6e-3,
 // 2.3e-3, 1.1e-3). With elements of 2.5e-4 m at the band ends growing linearly to 5e-3 m

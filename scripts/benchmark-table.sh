@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every bundled benchmark case in release mode and prints the Markdown table of the
-# README ("Accuracy against the classical solutions"). Outputs go to out/bench/<case>/.
+# docs/validation.md ("Accuracy against the classical solutions"). Outputs go to out/bench/<case>/.
 # Usage: scripts/benchmark-table.sh [case-name ...]   (default: all of cases/*.toml)
 set -euo pipefail
 cd "$(dirname "$0")/.."

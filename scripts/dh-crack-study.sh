@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The seed 004 §4.3 study of the README: runs the four dual-horizon crack plates to 0.5 s and
-# compares each with the uniform (k, m) = (1, 1) run at every output time, leaving out the
+# The Wang, Oterkus & Oterkus §4.3 study of docs/validation.md: runs the four dual-horizon crack
+# plates to 0.5 s and compares each with the uniform (k, m) = (1, 1) run at every output time, leaving out the
 # nodes within 2δ of a crack tip (`peritherm compare --exclude-tips`).
 # Outputs go to out/dh-crack/<case>/. Usage: scripts/dh-crack-study.sh
 set -euo pipefail

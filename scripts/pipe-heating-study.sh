@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Seed 001 §3.4, Fig. 11: the global error ε (seed 001 eq 27) of the 2D axisymmetric pipe
-# heating at t = 5 h for particle sizes Δ = 0.04, 0.02, 0.01 m and horizon ratios
-# m = δ/Δ = 2 … 8, against the FEM solution on the graded triangles of
-# meshes/pipe_heating_fem.msh (cases/pipe_heating_2d.toml's own reference).
+# The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.4, Fig. 11: the global
+# error ε (the paper's eq. 27) of the 2D axisymmetric pipe heating at
+# t = 5 h for particle sizes Δ = 0.04, 0.02, 0.01 m and horizon ratios m = δ/Δ = 2 … 8, against the
+# FEM solution on the graded triangles of meshes/pipe_heating_fem.msh (cases/pipe_heating_2d.toml's
+# own reference).
 # 1. runs cases/pipe_heating_2d.toml (PD at Δ = 0.02, m = 3 and its FEM reference, 10 h) into
 #    OUT/case, whose FEM run OUT/case/fem is the reference of the study;
 # 2. sweeps the 21 variants (mesh pipe_heating_d<Δ>.msh × horizon factor m), each to 5 h with
@@ -31,7 +32,7 @@ for r in rows:
     eps[(d, int(float(r["region.*.horizon.factor"])))] = float(r["epsilon"])
 ds = ["0.04", "0.02", "0.01"]
 ms = sorted({m for _, m in eps})
-print("ε (seed 001 eq 27) at t = 5 h against the graded FEM reference, in %:")
+print("ε (the axisymmetric phase-change paper, eq. 27) at t = 5 h against the graded FEM reference, in %:")
 print()
 print("| Δ (m) | " + " | ".join(f"m = {m}" for m in ms) + " |")
 print("|---|" + "---|" * len(ms))

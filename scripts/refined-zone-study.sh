@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The refined-zone study of the README: runs the seed 003 Example 3 crack plate on the
-# refined gmsh mesh and on the uniform fine one, then compares the two fields at every output
+# The refined-zone study of docs/validation.md: runs the Bobaru & Duangpanya 2012 Example 3 crack plate on
+# the refined gmsh mesh and on the uniform fine one, then compares the two fields at every output
 # time (`peritherm compare`: the uniform run interpolated at the refined run's nodes by a
 # local linear least-squares fit that does not look across the crack).
 # Outputs go to out/study/{refined,uniform}/. Usage: scripts/refined-zone-study.sh

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Runs the seed 001 §3.1–3.4 cases (axisymmetric and spherical) and prints the Markdown
-# table of the README's "Axial and spherical symmetry" section: ε (seed 001 eq 27) and the
-# largest nodal difference against each case's reference at every output time.
-# Outputs go to out/symmetry/<case>/ (each FEM reference in <case>/fem/).
-# Usage (from the repository root): bash scripts/symmetry-table.sh   (about 25 s on 2 cores once built)
+# Runs the axisymmetric phase-change paper §3.1–3.4 cases (axisymmetric and spherical) and prints
+# the Markdown table of docs/validation.md ("Axial and spherical symmetry: cases"): ε (the axisymmetric
+# phase-change paper, doi:10.1007/s42102-022-00092-3, eq. 27) and the largest nodal difference
+# against each case's reference at every output time. Outputs go to out/symmetry/<case>/ (each FEM
+# reference in <case>/fem/). Usage (from the repository root): bash scripts/symmetry-table.sh
+# (about 25 s on 2 cores once built)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet

@@ -26,7 +26,8 @@ pub enum AxisEnds {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Reference {
-    /// Both ends held, constant initial temperature (seed 000 eq 33; seed 004 §4.1).
+    /// Both ends held, constant initial temperature (Bobaru & Duangpanya 2010, eq. 33; Wang,
+    /// Oterkus & Oterkus §4.1).
     BarFixedEnds {
         /// Coordinate of the left end, m.
         x0: f64,
@@ -41,7 +42,8 @@ pub enum Reference {
         /// Initial θ, °C.
         initial: f64,
     },
-    /// Left end insulated, right end held, two-step initial field (seed 000 eq 38).
+    /// Left end insulated, right end held, two-step initial field (Bobaru & Duangpanya 2010, eq.
+    /// 38).
     BarInsulatedLeft {
         /// Coordinate of the left end, m.
         x0: f64,
@@ -56,7 +58,8 @@ pub enum Reference {
         /// Initial θ on s > L/2, °C.
         initial_right: f64,
     },
-    /// Left end held, gradient θ_s given at the right end (seed 000 eq 43; seed 003 eq 18 with 0).
+    /// Left end held, gradient θ_s given at the right end (Bobaru & Duangpanya 2010, eq. 43; Bobaru
+    /// & Duangpanya 2012, eq. 18 with 0).
     BarFixedFlux {
         /// Coordinate of the left end, m.
         x0: f64,
@@ -71,7 +74,8 @@ pub enum Reference {
         /// Initial θ, °C.
         initial: f64,
     },
-    /// Left end at A t e^(−r t), right end insulated, initial 0 (seed 004 §4.2, Duhamel).
+    /// Left end at A t e^(−r t), right end insulated, initial 0 (Wang, Oterkus & Oterkus §4.2,
+    /// Duhamel).
     BarPulseLeft {
         /// Coordinate of the left end, m.
         x0: f64,
@@ -84,7 +88,8 @@ pub enum Reference {
         /// Rate r, 1/s.
         rate: f64,
     },
-    /// Square with all edges held, constant initial temperature (seed 003 Example 1).
+    /// Square with all edges held, constant initial temperature (Bobaru & Duangpanya 2012 Example
+    /// 1).
     SquareFixedEdges {
         /// Coordinates of the lower-left corner, m.
         x0: f64,
@@ -100,8 +105,9 @@ pub enum Reference {
         initial: f64,
     },
     /// Sphere of radius R about the origin, surface held, uniform initial temperature
-    /// (seed 001 §3.2): θ = θ_s + (θ_0 − θ_s)(2R/(πr)) Σ (−1)^(n+1)/n sin(nπr/R)
-    /// e^(−α n²π² t/R²), r = √(x² + y² + z²) (the radius of a 1D radial model is x).
+    /// (the axisymmetric phase-change paper, doi:10.1007/s42102-022-00092-3, §3.2): θ = θ_s + (θ_0
+    /// − θ_s)(2R/(πr)) Σ (−1)^(n+1)/n sin(nπr/R) e^(−α n²π² t/R²), r = √(x² + y² + z²) (the radius
+    /// of a 1D radial model is x).
     SphereFixedSurface {
         /// Radius R, m.
         radius: f64,
@@ -112,7 +118,7 @@ pub enum Reference {
         /// Initial θ, °C (or K).
         initial: f64,
     },
-    /// Neumann's solution of planar freezing (formulation §6): a liquid at `initial` > T_f
+    /// Neumann's solution of planar freezing (theory §6): a liquid at `initial` > T_f
     /// fills s = x − x0 > 0 and the face s = 0 is held at `surface` < T_f from t = 0. The
     /// front is at X(t) = 2λ√(α_f t) ([`neumann_front`]); one density for both phases.
     NeumannFreezing {
@@ -912,7 +918,8 @@ mod tests {
         assert!((sphere.eval(rs, 0.0, 0.0, 1.0) - ts).abs() < 1e-9 * t0);
     }
 
-    /// Seed 000's printed midpoint values at t = 8 s (±0.005 °C: the paper prints 2 decimals).
+    /// The midpoint values printed by Bobaru & Duangpanya 2010 at t = 8 s (±0.005 °C: the paper
+    /// prints 2 decimals).
     #[test]
     fn seed000_midpoints() {
         let ex1 = Reference::BarFixedEnds {

@@ -1,16 +1,17 @@
-//! Boundary conditions and loads of formulation §3, applied to a state vector.
+//! Boundary conditions and loads of theory §3, applied to a state vector.
 //!
 //! Constraints overwrite node temperatures at each stage (nodal Dirichlet, the 1D flux
-//! relation of seed 000 eq 22, the nodal flux relation of seed 003 §3.2, and the
-//! fictitious layers of seed 004 / seed 001); loads add to the rates (convection of
-//! seed 001, volumetric sources).
+//! relation of Bobaru & Duangpanya 2010, eq. 22, the nodal flux relation of Bobaru & Duangpanya
+//! 2012 §3.2, and the fictitious layers of Wang, Oterkus & Oterkus and the axisymmetric
+//! phase-change paper); loads add to the rates (convection of the axisymmetric phase-change paper
+//! (doi:10.1007/s42102-022-00092-3), volumetric sources).
 
 use crate::cloud::{Cloud, Fictitious, Reflection};
 use crate::expr::Expr;
 use crate::math::{NodeId, Point};
 use crate::spatial::PointIndex;
 
-/// How a fictitious layer takes its temperature from the body (formulation §3).
+/// How a fictitious layer takes its temperature from the body (theory §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Layer {
     /// θ_f = θ_b(t).
@@ -22,9 +23,10 @@ pub enum Layer {
 /// The condition on one boundary set (a box face or a mesh's physical group).
 #[derive(Debug, Clone, PartialEq)]
 pub enum FaceBc {
-    /// No bonds leave the body: insulated with the surface skin effect (seed 003 §3.5).
+    /// No bonds leave the body: insulated with the surface skin effect (Bobaru & Duangpanya 2012
+    /// §3.5).
     Free,
-    /// Nodal Dirichlet on the first `layers` node layers (seeds 000, 003).
+    /// Nodal Dirichlet on the first `layers` node layers (Bobaru & Duangpanya 2010, 2012).
     NodalTemperature {
         /// θ_b(x, y, z, t), °C.
         value: Expr,
@@ -45,21 +47,23 @@ pub enum FaceBc {
         /// q(x, y, z, t) into the body, W/m².
         value: Expr,
     },
-    /// Heat flux into the body by a nodal relation: seed 000 eq 22 in 1D, seed 003 §3.2 in 2D/3D.
+    /// Heat flux into the body by a nodal relation: Bobaru & Duangpanya 2010, eq. 22 in 1D, Bobaru
+    /// & Duangpanya 2012 §3.2 in 2D/3D.
     RelationFlux {
         /// q(x, y, z, t) into the body, W/m².
         value: Expr,
     },
-    /// Convection through a mirrored fictitious layer (seed 001 §3.1c): the ghost at distance d
-    /// from its mirror node satisfies k(θ_f − θ_m)/d = h(T∞ − (θ_f + θ_m)/2), i.e.
-    /// θ_f = ((1 − β/2) θ_m + β T∞)/(1 + β/2) with β = h d/k.
+    /// Convection through a mirrored fictitious layer (the axisymmetric phase-change paper §3.1c):
+    /// the ghost at distance d from its mirror node satisfies k(θ_f − θ_m)/d = h(T∞ − (θ_f +
+    /// θ_m)/2), i.e. θ_f = ((1 − β/2) θ_m + β T∞)/(1 + β/2) with β = h d/k.
     LayerConvection {
         /// Film coefficient h, W/(m²·K).
         h: f64,
         /// T∞(t), °C.
         ambient: Expr,
     },
-    /// Convection to an ambient temperature (seed 001): s = h A (T∞ − θ)/V on surface nodes.
+    /// Convection to an ambient temperature (the axisymmetric phase-change paper): s = h A (T∞ −
+    /// θ)/V on surface nodes.
     Convection {
         /// Film coefficient h, W/(m²·K).
         h: f64,
@@ -88,7 +92,8 @@ struct Nodal {
     value: Expr,
 }
 
-/// Seed 000 eq 22: θ_s = θ_anchor + (q/k)(d_anchor − d_s) for the nodes within δ of the end.
+/// Bobaru & Duangpanya 2010, eq. 22: θ_s = θ_anchor + (q/k)(d_anchor − d_s) for the nodes within δ
+/// of the end.
 #[derive(Debug, Clone)]
 struct Relation1d {
     slaved: Vec<(usize, f64)>,
@@ -98,7 +103,7 @@ struct Relation1d {
     at: Point,
 }
 
-/// Seed 003 §3.2: θ_i = (Σ_p w_p θ_p + q) / Σ_p w_p over the inward half of H_i.
+/// Bobaru & Duangpanya 2012 §3.2: θ_i = (Σ_p w_p θ_p + q) / Σ_p w_p over the inward half of H_i.
 #[derive(Debug, Clone)]
 struct RelationNodal {
     node: usize,
@@ -152,7 +157,8 @@ pub struct BoundaryInput<'a> {
     pub conductivity: &'a [f64],
     /// Volumetric heat capacity per node, J/(m³·K).
     pub capacity: &'a [f64],
-    /// Directed bonds and their micro-conductance per unit volume pair (for seed 003 §3.2).
+    /// Directed bonds and their micro-conductance per unit volume pair (for Bobaru & Duangpanya
+    /// 2012 §3.2).
     pub micro: Option<(&'a crate::neighbors::Horizons, &'a [f64])>,
     /// Volumetric source, W/m³.
     pub source: Option<Expr>,
@@ -376,7 +382,7 @@ impl Boundary {
     }
 
     /// [`Boundary::apply`] with the body's conductivity as it is now (phase change,
-    /// formulation §6): a mirrored flux layer then takes q/k with k at its mirror point, W/(m·K).
+    /// theory §6): a mirrored flux layer then takes q/k with k at its mirror point, W/(m·K).
     pub fn apply_with(
         &self,
         cloud: &Cloud,
@@ -485,7 +491,7 @@ impl Boundary {
 
     /// The linear part of every constraint, in the order [`Boundary::apply`] sets them:
     /// `(node, [(source, weight)])` with θ_node = Σ weight·θ_source + (a part that depends on t
-    /// only: `apply` on a field whose free nodes are 0 gives it). Formulation §3; the implicit
+    /// only: `apply` on a field whose free nodes are 0 gives it). Theory §3; the implicit
     /// solvers eliminate constrained and fictitious nodes with it.
     pub fn linear_rules(&self) -> Vec<(usize, Vec<(usize, f64)>)> {
         let mut out = Vec::new();

@@ -35,7 +35,8 @@ pub struct BenchOptions {
     pub cases: Option<PathBuf>,
 }
 
-/// The explicit/implicit pairs of the README's "Implicit and steady solvers" comparison.
+/// The explicit/implicit pairs of the comparison in docs/performance.md ("Time to solution,
+/// explicit against implicit").
 pub const CASES: [&str; 4] = [
     "cases/dh_crack_plate_k1_m1.toml",
     "cases/dh_crack_plate_k1_m1_implicit.toml",

@@ -1,6 +1,6 @@
 //! Case files: the TOML schema, its validation, and the conversion to a [`ModelSpec`].
 //!
-//! Every key is documented in the README's case-file reference. Unknown keys, missing
+//! Every key is documented in docs/case-reference.md. Unknown keys, missing
 //! fields and out-of-range values are errors that name the file and the key.
 
 use crate::analytic::Reference;
@@ -45,7 +45,8 @@ pub struct CaseFile {
     pub title: String,
     /// Spatial dimension, 1..=3.
     pub dimension: usize,
-    /// `planar` (default), `axisymmetric` (x = r, y = z) or `spherical` (x = r); seed 001.
+    /// `planar` (default), `axisymmetric` (x = r, y = z) or `spherical` (x = r); the axisymmetric
+    /// phase-change paper (doi:10.1007/s42102-022-00092-3).
     #[serde(default)]
     pub symmetry: Symmetry,
     /// The built-in box domain (or give `mesh`).
@@ -163,10 +164,10 @@ pub struct CrackSpec {
 #[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Placement {
-    /// Cell-centred nodes of equal volume (seed 000 §3, seed 004).
+    /// Cell-centred nodes of equal volume (Bobaru & Duangpanya 2010 §3; Wang, Oterkus & Oterkus).
     #[default]
     Cell,
-    /// Nodes on the boundary with partial volumes (seed 003 §3).
+    /// Nodes on the boundary with partial volumes (Bobaru & Duangpanya 2012 §3).
     Boundary,
 }
 
@@ -240,7 +241,7 @@ pub struct KernelSpec {
 
 /// On a mesh, every boundary set that no `[boundary]` names (and the facets in no group,
 /// unless `[boundary."(no group)"]` names them) is insulated through a mirrored layer: the
-/// surface correction of the free-surface skin effect (formulation §3). `type = "free"` keeps
+/// surface correction of the free-surface skin effect (theory §3). `type = "free"` keeps
 /// the uncorrected surface; crack groups stay as they are.
 fn unnamed_insulated(
     faces: &mut [FaceBc],
@@ -371,7 +372,8 @@ pub struct TimeSpec {
     /// Time step, s (default: 0.95 of the stable bound).
     #[serde(default)]
     pub dt: Option<f64>,
-    /// euler, rk4 or an implicit scheme (default rk4; euler with phase change, seed 001).
+    /// euler, rk4 or an implicit scheme (default rk4; euler with phase change, the axisymmetric
+    /// phase-change paper).
     #[serde(default)]
     pub integrator: Option<Integrator>,
     /// Output times, s (default: the end time).
@@ -399,10 +401,11 @@ pub struct ReferenceSection {
     /// The built-in classical FEM solve of the same case.
     #[serde(default)]
     pub fem: Option<FemReferenceSpec>,
-    /// Probe line for seed 003 eq 13: nodes within half a spacing of `y = line_y`, m.
+    /// Probe line for Bobaru & Duangpanya 2012, eq. 13: nodes within half a spacing of `y =
+    /// line_y`, m.
     #[serde(default)]
     pub line_y: Option<f64>,
-    /// A vertical probe line x = `line_x` for the report's plots (seed 004 §4.3), m.
+    /// A vertical probe line x = `line_x` for the report's plots (Wang, Oterkus & Oterkus §4.3), m.
     #[serde(default)]
     pub line_x: Option<f64>,
     /// More vertical probe lines x = each value for the report's plots, m.
@@ -414,7 +417,8 @@ pub struct ReferenceSection {
     /// Leave the nodes within this distance of a crack tip out of the measures, m.
     #[serde(default)]
     pub exclude_tips: Option<f64>,
-    /// A point whose nearest body node is reported at every output (e.g. seed 000's midpoint), m.
+    /// A point whose nearest body node is reported at every output (e.g. the midpoint of Bobaru &
+    /// Duangpanya 2010), m.
     #[serde(default)]
     pub probe: Option<Vec<f64>>,
 }
@@ -453,7 +457,7 @@ pub enum ReferenceSource {
 pub struct ReferenceSpec {
     /// The classical solution.
     pub source: ReferenceSource,
-    /// Probe line for seed 003 eq 13 (y = line_y), m.
+    /// Probe line for Bobaru & Duangpanya 2012, eq. 13 (y = line_y), m.
     pub line_y: Option<f64>,
     /// Vertical probe line x = line_x of the report, m.
     pub line_x: Option<f64>,

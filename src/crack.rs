@@ -1,9 +1,9 @@
-//! Bond cutting: pre-cracks and the boundary of non-convex bodies (formulation §5).
+//! Bond cutting: pre-cracks and the boundary of non-convex bodies (theory §5).
 //!
 //! A bond AB is cut by a crack segment CD when A and B lie strictly on opposite sides of CD's
-//! line and C and D on opposite sides of AB's (seed 003 §3.4). A bond through an interior
-//! vertex of a crack polyline is cut; one that only touches a crack tip is not. In 3D a bond
-//! is cut when it passes through a crack triangle. Bonds between body nodes that leave the
+//! line and C and D on opposite sides of AB's (Bobaru & Duangpanya 2012 §3.4). A bond through an
+//! interior vertex of a crack polyline is cut; one that only touches a crack tip is not. In 3D a
+//! bond is cut when it passes through a crack triangle. Bonds between body nodes that leave the
 //! body (across a hole or a re-entrant corner) are cut by the body's boundary facets, and a
 //! fictitious node's bonds may cross only the sets it was mirrored across.
 
@@ -30,7 +30,7 @@ pub struct Cutter {
 }
 
 /// A crack that grows along its polyline from the first point at a constant speed
-/// (seed 003 Example 5): at time t it covers the path up to arc length
+/// (Bobaru & Duangpanya 2012 Example 5): at time t it covers the path up to arc length
 /// `initial + speed (t − start)`, and each bond is cut when the tip passes its crossing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Growth {
@@ -266,8 +266,8 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> C
 
 /// Skin correction at cracks (beyond the papers): a node whose bonds a crack cuts loses
 /// part of its horizon's second moment Σ_j w_ij |ξ_ij|², so the conductivity along the crack
-/// face drops (the skin effect seed 003 accepts). This scales the node's own directed
-/// weights by the moment of all its bonds over the moment of the bonds the crack leaves
+/// face drops (the skin effect Bobaru & Duangpanya 2012 accept). This scales the node's own
+/// directed weights by the moment of all its bonds over the moment of the bonds the crack leaves
 /// (`mu` = the cracks' μ per directed bond), restoring the moment; K stays symmetric since
 /// K_ij = V_i V_j (w_ij + w_ji).
 pub fn restore_moment(cloud: &Cloud, horizons: &Horizons, mu: &[f64], weights: &mut [f64]) {
@@ -298,7 +298,7 @@ pub fn restore_moment(cloud: &Cloud, horizons: &Horizons, mu: &[f64], weights: &
         });
 }
 
-/// Damage of every body node (formulation §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
+/// Damage of every body node (theory §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
 /// the directed bonds of i (0 intact, 1 with every bond cut).
 pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {
     (0..cloud.n_body)
@@ -385,7 +385,7 @@ mod tests {
     }
 
     /// A bond crossing a segment is cut; one touching only its tip is not; one through an
-    /// interior vertex of a polyline is (seed 003 §3.4).
+    /// interior vertex of a polyline is (Bobaru & Duangpanya 2012 §3.4).
     #[test]
     fn crossing_tips_and_vertices() {
         let crack = segments(

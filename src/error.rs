@@ -31,8 +31,8 @@ pub enum Error {
         /// The reason.
         message: String,
     },
-    /// A time step above the stability bound of formulation §4.
-    #[error("{dt:.4e} s exceeds the stable bound {bound:.4e} s of the {integrator} integrator (formulation §4); use a smaller time.dt or omit it")]
+    /// A time step above the stability bound of theory §4.
+    #[error("{dt:.4e} s exceeds the stable bound {bound:.4e} s of the {integrator} integrator (theory §4); use a smaller time.dt or omit it")]
     UnstableDt {
         /// The requested step, s.
         dt: f64,
@@ -49,7 +49,7 @@ pub enum Error {
         /// Simulation time, s.
         time: f64,
     },
-    /// A linear solve of the implicit or steady solvers failed (formulation §4).
+    /// A linear solve of the implicit or steady solvers failed (theory §4).
     #[error("linear solver: {message}")]
     Solver {
         /// What failed and why.

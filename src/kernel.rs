@@ -1,10 +1,10 @@
 //! Micro-conductivity kernels and partial volumes: the only home of their constants.
 //!
 //! A node's micro-conductance for a bond of length r is `c_i(r) = C_i w(r/δ_i) / r^p`
-//! (formulation §2.1), with `C_i = 2 d k_i / ∫_{H_i} w(r/δ_i) r^(2−p) dV` so that a smooth
+//! (theory §2.1), with `C_i = 2 d k_i / ∫_{H_i} w(r/δ_i) r^(2−p) dV` so that a smooth
 //! field in a full horizon gives the classical conductivity k_i. p = 2 with the constant or
-//! the triangular/conical profile is Bobaru & Duangpanya (seed 000 eqs 16–17, seed 003
-//! §2.3); p = 1 with the constant profile is Oterkus et al. (seed 004 eq 18).
+//! the triangular/conical profile is Bobaru & Duangpanya's (2010, eqs. 16–17; 2012
+//! §2.3); p = 1 with the constant profile is Wang, Oterkus & Oterkus's (eq. 18).
 
 use serde::{Deserialize, Serialize};
 
@@ -16,21 +16,23 @@ pub const ROUNDOFF: f64 = 1e-9;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
-    /// w = 1 (seed 000 eq 16, seed 003 §2.3.1, seed 004 eq 18).
+    /// w = 1 (Bobaru & Duangpanya 2010, eq. 16; Bobaru & Duangpanya 2012 §2.3.1; Wang, Oterkus &
+    /// Oterkus, eq. 18).
     Constant,
-    /// w = 1 − r/δ: "triangular" in 1D (seed 000 eq 17), "conical" in 2D/3D (seed 003 §2.3.2).
+    /// w = 1 − r/δ: "triangular" in 1D (Bobaru & Duangpanya 2010, eq. 17), "conical" in 2D/3D
+    /// (Bobaru & Duangpanya 2012 §2.3.2).
     #[serde(alias = "triangular")]
     Conical,
 }
 
-/// How much of a neighbour's volume lies inside a horizon (formulation §2.3).
+/// How much of a neighbour's volume lies inside a horizon (theory §2.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PartialVolume {
-    /// β = 1 for r ≤ δ, else 0 (non-uniform m-convergence, seed 003 §3.3).
+    /// β = 1 for r ≤ δ, else 0 (non-uniform m-convergence, Bobaru & Duangpanya 2012 §3.3).
     AllOrNothing,
-    /// Seed 003 Algorithm 1: β falls linearly over δ ± Δ_j/2; with the conical profile
-    /// w is evaluated at the centroid of the covered part (lines 6 and 9).
+    /// Bobaru & Duangpanya 2012 Algorithm 1: β falls linearly over δ ± Δ_j/2; with the conical
+    /// profile w is evaluated at the centroid of the covered part (lines 6 and 9).
     Algorithm1,
 }
 
@@ -38,20 +40,22 @@ pub enum PartialVolume {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Calibration {
-    /// Exact integration over the full horizon (formulation §2.1).
+    /// Exact integration over the full horizon (theory §2.1).
     #[default]
     Continuum,
     /// The midpoint sum over the node's own lattice (cell-centred, spacing Δ_i, the same
     /// partial volumes), so that the discrete bulk operator has conductivity k exactly. The
     /// midpoint rule misses the node's own cell: 1/m of the moment in 1D (12.5 % at m = 4),
-    /// which seed 000 eq 18 restores with its p = i term; this does it for every kernel.
+    /// which the p = i term of Bobaru & Duangpanya 2010 (eq. 18) restores; this does it for every
+    /// kernel.
     Lattice,
 }
 
 /// A micro-conductivity kernel: exponent p, profile and partial-volume rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Kernel {
-    /// Exponent p of 1/r^p: 2 (seeds 000, 001, 003) or 1 (seed 004).
+    /// Exponent p of 1/r^p: 2 (Bobaru & Duangpanya 2010, 2012; the axisymmetric phase-change paper)
+    /// or 1 (Wang, Oterkus & Oterkus).
     pub p: u8,
     /// Profile w.
     pub profile: Profile,
@@ -82,7 +86,7 @@ impl Kernel {
         sphere_measure(dim) * radial
     }
 
-    /// Normalisation C_i (formulation §2.1) for conductivity `k` (W/(m·K)), horizon `delta` (m)
+    /// Normalisation C_i (theory §2.1) for conductivity `k` (W/(m·K)), horizon `delta` (m)
     /// and out-of-plane measure `tau` (cross-section area in 1D, thickness in 2D, 1 in 3D).
     pub fn normalisation(&self, dim: usize, k: f64, delta: f64, tau: f64) -> f64 {
         2.0 * dim as f64 * k / (tau * self.moment(dim, delta))
@@ -187,27 +191,27 @@ mod tests {
     fn normalisations_match_the_papers() {
         let (k, d, a) = (1.7, 0.3, 0.2);
         let close = |x: f64, y: f64| assert!((x - y).abs() <= 1e-13 * y.abs(), "{x} vs {y}");
-        // seed 000 eq 16: k0 = κ/δ (per cross-section A)
+        // Bobaru & Duangpanya 2010, eq. 16: k0 = κ/δ (per cross-section A)
         close(
             kern(2, Profile::Constant).normalisation(1, k, d, a),
             k / d / a,
         );
-        // seed 000 eq 17: k1 = 2κ/δ
+        // Bobaru & Duangpanya 2010, eq. 17: k1 = 2κ/δ
         close(
             kern(2, Profile::Conical).normalisation(1, k, d, a),
             2.0 * k / d / a,
         );
-        // seed 003 §2.3.1: 4κ/(πδ²) per thickness h
+        // Bobaru & Duangpanya 2012 §2.3.1: 4κ/(πδ²) per thickness h
         close(
             kern(2, Profile::Constant).normalisation(2, k, d, a),
             4.0 * k / (PI * d * d * a),
         );
-        // seed 003 §2.3.2: 12κ/(πδ²)
+        // Bobaru & Duangpanya 2012 §2.3.2: 12κ/(πδ²)
         close(
             kern(2, Profile::Conical).normalisation(2, k, d, a),
             12.0 * k / (PI * d * d * a),
         );
-        // seed 004 eq 18: 6k/(πhδ³)
+        // Wang, Oterkus & Oterkus, eq. 18: 6k/(πhδ³)
         close(
             kern(1, Profile::Constant).normalisation(2, k, d, a),
             6.0 * k / (PI * a * d.powi(3)),
@@ -299,7 +303,8 @@ mod tests {
         let (b, at) = k.coverage(1.05, 1.0, 0.2);
         assert!((b - 0.25).abs() < 1e-12 && (at - (1.0 - 0.2 * 0.25 / 2.0)).abs() < 1e-12);
         assert_eq!(k.coverage(1.2, 1.0, 0.2).0, 0.0);
-        // a neighbour one round-off inside the outer edge is outside, one ten times further in is not
+        // a neighbour one round-off inside the outer edge is outside, one ten times further in is
+        // not
         assert_eq!(k.coverage(1.1 - 1e-12, 1.0, 0.2).0, 0.0);
         assert!(k.coverage(1.1 - 1e-8, 1.0, 0.2).0 > 0.0);
     }

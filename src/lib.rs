@@ -1,8 +1,10 @@
 //! peritherm: transient heat conduction with dual-horizon peridynamics.
 //!
-//! The numerics follow `formulation.md` (the project's contract), which reconciles
-//! Bobaru & Duangpanya 2010 (seed 000), 2012 (seed 003), the axisymmetric/phase-change
-//! paper (seed 001) and Wang, Oterkus & Oterkus's dual-horizon thermal diffusion (seed 004).
+//! The numerics follow `docs/theory.md` (the model in one notation), which reconciles four
+//! papers: Bobaru & Duangpanya 2010 (1D), Bobaru & Duangpanya 2012 (2D, cracks), the
+//! axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) and Wang, Oterkus &
+//! Oterkus's dual-horizon thermal diffusion; the full references are at the end of
+//! `docs/theory.md`.
 //!
 //! Flow: [`case`] (TOML) → [`model::ModelSpec`] → [`cloud`] → [`neighbors`] →
 //! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.

@@ -93,7 +93,7 @@ enum Command {
     /// into --out/<variant>/, and sweep.csv and sweep.md (one row per variant and output time).
     Sweep {
         /// Case files (each is swept over the --vary values; several files are compared as
-        /// one study, e.g. the four (k, m) configurations of seed 004).
+        /// one study, e.g. the four (k, m) configurations of Wang, Oterkus & Oterkus).
         #[arg(required = true)]
         cases: Vec<PathBuf>,
         /// KEY=V1,V2,...: a dotted key of the case file and its values (array items by index,

@@ -1,5 +1,6 @@
-//! Materials, their enthalpy–temperature relation (formulation §6, seed 001 eqs 1–3) and the
-//! bond-conductivity rule at interfaces (formulation §2.4).
+//! Materials, their enthalpy–temperature relation (theory §6, the axisymmetric phase-change paper
+//! (doi:10.1007/s42102-022-00092-3), eqs. 1–3) and the bond-conductivity rule at interfaces (theory
+//! §2.4).
 
 use serde::{Deserialize, Serialize};
 
@@ -13,12 +14,14 @@ pub struct Material {
     pub density: f64,
     /// Specific heat c (C_m), J/(kg·K).
     pub specific_heat: f64,
-    /// Freezing/melting at one temperature (seed 001 §2.1); None for a linear material.
+    /// Freezing/melting at one temperature (the axisymmetric phase-change paper §2.1); None for a
+    /// linear material.
     #[serde(default)]
     pub phase_change: Option<PhaseChange>,
 }
 
-/// `[material.<name>.phase_change]`: the frozen phase and the latent heat (seed 001 eqs 1–3).
+/// `[material.<name>.phase_change]`: the frozen phase and the latent heat (the axisymmetric
+/// phase-change paper, eqs. 1–3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PhaseChange {
@@ -42,7 +45,7 @@ fn one() -> f64 {
     1.0
 }
 
-/// The enthalpy per unit volume H(θ) ↔ θ(H) relation of one material (formulation §6), with
+/// The enthalpy per unit volume H(θ) ↔ θ(H) relation of one material (theory §6), with
 /// H = ρ_f C_f θ below T_f (H = ρcθ for a linear material). Precomputed for the time loop.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Enthalpy {
@@ -63,7 +66,7 @@ pub struct Enthalpy {
 }
 
 impl Enthalpy {
-    /// Temperature at enthalpy `h` (seed 001 eq. 3), °C.
+    /// Temperature at enthalpy `h` (the axisymmetric phase-change paper, eq. 3), °C.
     #[inline]
     pub fn temperature(&self, h: f64) -> f64 {
         if h < self.h_solid {
@@ -85,8 +88,8 @@ impl Enthalpy {
         }
     }
 
-    /// Conductivity at enthalpy `h` (seed 001 eq. 1: the mean of λ_f and λ_m on the plateau),
-    /// W/(m·K).
+    /// Conductivity at enthalpy `h` (the axisymmetric phase-change paper, eq. 1: the mean of λ_f
+    /// and λ_m on the plateau), W/(m·K).
     #[inline]
     pub fn conductivity(&self, h: f64) -> f64 {
         if h < self.h_solid {
@@ -207,7 +210,7 @@ impl Material {
         Ok(())
     }
 
-    /// The material's enthalpy relation (formulation §6).
+    /// The material's enthalpy relation (theory §6).
     pub fn enthalpy(&self) -> Enthalpy {
         match self.phase_change {
             None => Enthalpy {
@@ -246,14 +249,14 @@ impl Material {
     }
 }
 
-/// How a bond between two materials takes its conductivity (formulation §2.4).
+/// How a bond between two materials takes its conductivity (theory §2.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BondRule {
-    /// 2 k_a k_b / (k_a + k_b) (seed 001, default).
+    /// 2 k_a k_b / (k_a + k_b) (the axisymmetric phase-change paper, default).
     #[default]
     Harmonic,
-    /// min(k_a, k_b) (seed 003, composites).
+    /// min(k_a, k_b) (Bobaru & Duangpanya 2012, composites).
     Lower,
     /// (k_a + k_b) / 2.
     Arithmetic,
@@ -299,7 +302,7 @@ mod tests {
         for t in [200.0, 273.0, 273.2, 300.0, 373.15] {
             assert!((e.temperature(e.enthalpy(t)) - t).abs() < 1e-9 * t, "{t}");
         }
-        // seed 001 eq 3: the plateau is ρ_f Π L wide and sits at T_f
+        // the axisymmetric phase-change paper, eq. 3: the plateau is ρ_f Π L wide and sits at T_f
         let hs = 1000.0 * 2060.0 * 273.15;
         assert_eq!(e.temperature(hs + 0.5 * 1000.0 * 333e3), 273.15);
         assert!((e.temperature(hs + 1000.0 * 333e3 + 4182.0e3) - 274.15).abs() < 1e-9);

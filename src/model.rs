@@ -73,7 +73,7 @@ pub enum CrackShape {
     Polygon(Vec<Point>),
 }
 
-/// A pre-crack (formulation §5).
+/// A pre-crack (theory §5).
 #[derive(Debug, Clone)]
 pub struct Crack {
     /// Its shape.
@@ -109,11 +109,11 @@ pub struct ModelSpec {
     /// Restore, at nodes whose bonds a pre-crack cuts, the second moment of their horizon
     /// ([`crate::crack::restore_moment`]).
     pub crack_correction: bool,
-    /// Planar, axisymmetric or spherical body (seed 001, formulation §7).
+    /// Planar, axisymmetric or spherical body (the axisymmetric phase-change paper; theory §7).
     pub symmetry: Symmetry,
 }
 
-/// Cutting facets of the cracks (formulation §5).
+/// Cutting facets of the cracks (theory §5).
 pub fn crack_cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
     let mut out = Vec::new();
     for c in cracks {
@@ -165,7 +165,7 @@ fn cutters(cloud: &Cloud, cracks: &[Crack]) -> Vec<Cutter> {
 
 /// Body nodes whose horizon is complete: no boundary without a fictitious layer within reach,
 /// no bond cut (by a crack or the boundary) and one material throughout (material interfaces
-/// keep the bond rule of formulation §2.4, cracks their own correction).
+/// keep the bond rule of theory §2.4, cracks their own correction).
 fn complete_horizons(
     cloud: &Cloud,
     horizons: &Horizons,
@@ -199,11 +199,11 @@ pub struct Model {
     pub capacity: Vec<f64>,
     /// 1 / (V_i ρc_i) per body node, K/J.
     pub inv_heat_capacity: Vec<f64>,
-    /// With phase change (formulation §6): each material's enthalpy relation, and then
+    /// With phase change (theory §6): each material's enthalpy relation, and then
     /// `conductance` holds K for unit conductivity, K_ij(t) = λ̄_ij(t)·K_ij with λ̄ from
     /// `bond_rule`; the boundary's loads are then in W/m³. None for a linear model.
     pub enthalpy: Option<Vec<Enthalpy>>,
-    /// Interface rule for the bond conductivity λ̄_ij (formulation §2.4).
+    /// Interface rule for the bond conductivity λ̄_ij (theory §2.4).
     pub bond_rule: BondRule,
     /// Boundary conditions and loads.
     pub boundary: Boundary,
@@ -424,7 +424,7 @@ impl Model {
         })
     }
 
-    /// Damage φ of every body node at time `t` (formulation §5), growing cracks included.
+    /// Damage φ of every body node at time `t` (theory §5), growing cracks included.
     pub fn damage_at(&self, t: f64) -> Vec<f64> {
         let c = &self.crack_cuts;
         if c.mu.is_empty() {
@@ -455,7 +455,7 @@ impl Model {
             .sum()
     }
 
-    /// Gershgorin bound on the largest eigenvalue of the free-node system, 1/s (formulation §4).
+    /// Gershgorin bound on the largest eigenvalue of the free-node system, 1/s (theory §4).
     ///
     /// With phase change K holds unit conductivities and the loads are per unit capacity, so
     /// the bound takes the largest conductivity and the smallest capacity of any phase.

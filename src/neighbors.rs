@@ -1,7 +1,7 @@
 //! Directed neighbour lists (CSR): j is listed under i when j lies in i's horizon.
 //!
-//! The relation is directed because horizons differ from node to node (seed 004 eqs 19–22:
-//! the α masks); each entry carries the partial-volume factor β_ij (formulation §2.3) and
+//! The relation is directed because horizons differ from node to node (Wang, Oterkus & Oterkus,
+//! eqs. 19–22: the α masks); each entry carries the partial-volume factor β_ij (theory §2.3) and
 //! nothing else (the distance at which Algorithm 1 evaluates the kernel profile is recomputed
 //! by [`crate::kernel::Kernel::coverage`] where it is needed). Built once, in parallel.
 

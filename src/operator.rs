@@ -1,9 +1,10 @@
-//! The bond operator: the symmetric pair conductance K of formulation §2.2 and its product.
+//! The bond operator: the symmetric pair conductance K of theory §2.2 and its product.
 //!
 //! `V_i ρc_i dθ_i/dt = Σ_j K_ij (θ_j − θ_i)` with `K_ij = V_i V_j (w_ij + w_ji)` and the
-//! directed half-conductances `w_ij = ½ c_i(|ξ_ij|) β_ij` (seed 004 eqs 19–24; w_ij = 0 when
-//! j ∉ H_i). K is symmetric, so the bond sum conserves energy exactly. Axisymmetric and
-//! spherical clouds multiply each pair by the factor of [`crate::symmetry`] (seed 001 eqs 10, 21).
+//! directed half-conductances `w_ij = ½ c_i(|ξ_ij|) β_ij` (Wang, Oterkus & Oterkus, eqs. 19–24;
+//! w_ij = 0 when j ∉ H_i). K is symmetric, so the bond sum conserves energy exactly. Axisymmetric
+//! and spherical clouds multiply each pair by the factor of [`crate::symmetry`] (the axisymmetric
+//! phase-change paper, eqs. 10 and 21).
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
@@ -50,7 +51,7 @@ pub fn directed_weights(
                 // where Algorithm 1 evaluates the profile (lines 6 and 9)
                 let (_, at) = kernel.coverage(r, delta, cloud.spacing[j]);
                 let c = kernel.micro(unit * k, r, at, delta);
-                // planar measures times the ring/shell pair factor (formulation §7)
+                // planar measures times the ring/shell pair factor (theory §7)
                 let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
                 let shape = if sym.is_symmetric() {
                     sym.pair_factor(ri, rj) / (sym.volume_factor(ri) * sym.volume_factor(rj))
@@ -81,7 +82,7 @@ pub const ROW_CHUNK: usize = 2048;
 
 /// Σ_k v_k (θ[c_k] − θ_i) over one row of K, W: four partial sums over the entries 4q + r,
 /// added as (s0 + s1) + (s2 + s3) after the remainder joined s0. The order is fixed by the row
-/// alone, so every thread count gives the same bits (formulation §2, gather form).
+/// alone, so every thread count gives the same bits (theory §2, gather form).
 #[inline(always)]
 pub fn row_sum(cols: &[NodeId], vals: &[f64], theta: &[f64], ti: f64) -> f64 {
     let n = cols.len().min(vals.len());
@@ -274,7 +275,7 @@ impl Conductance {
         }
     }
 
-    /// Peridynamic heat flux of every body node (formulation §8, seed 003 §2.2), W/m²:
+    /// Peridynamic heat flux of every body node (theory §8, Bobaru & Duangpanya 2012 §2.2), W/m²:
     /// q_i = −(1/V_i) Σ_{j hotter than i} K_ij (θ_j − θ_i) ξ_ij. With K_ij = V_i V_j c β this is
     /// the paper's sum over H⁺; it equals −k∇θ for a linear field in the bulk and stays finite
     /// at corners and crack tips.

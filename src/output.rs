@@ -54,9 +54,9 @@ pub fn vtu_path(dir: &Path, k: usize) -> PathBuf {
 pub struct Fields<'a> {
     /// Temperature of every node (body first), °C.
     pub theta: &'a [f64],
-    /// Damage φ per body node (formulation §5).
+    /// Damage φ per body node (theory §5).
     pub damage: &'a [f64],
-    /// Peridynamic heat flux per body node (formulation §8), W/m².
+    /// Peridynamic heat flux per body node (theory §8), W/m².
     pub flux: &'a [Vector],
     /// The case's classical reference at each body node, °C, if it has one.
     pub reference: Option<&'a [f64]>,
@@ -291,18 +291,19 @@ pub fn read_field(path: &Path) -> Result<FieldRows> {
     Ok(rows)
 }
 
-/// Comparison with a classical solution at one output time (formulation §9).
+/// Comparison with a classical solution at one output time (theory §9).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Comparison {
     /// Output time, s.
     pub time: f64,
     /// max |θ_c − θ_pd| over the body nodes, °C.
     pub max_abs_diff: f64,
-    /// Seed 000 eq 45: mean of ((θ_c − θ_pd)/θ_c)² over nodes with θ_c ≠ 0.
+    /// Bobaru & Duangpanya 2010, eq. 45: mean of ((θ_c − θ_pd)/θ_c)² over nodes with θ_c ≠ 0.
     pub mean_sq_rel_diff: f64,
-    /// Seed 003 eq 13 along the probe line (all nodes when no line is set).
+    /// Bobaru & Duangpanya 2012, eq. 13 along the probe line (all nodes when no line is set).
     pub l2_rel_line: f64,
-    /// Seed 001 eq 27: rms difference / max |θ_c|.
+    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
+    /// / max |θ_c|.
     pub epsilon: f64,
     /// Relative L2 error over all body nodes compared, weighted by node volume:
     /// √(Σ V_i (θ_pd − θ_c)² / Σ V_i θ_c²), dimensionless (0 where θ_c ≡ 0).
@@ -358,7 +359,8 @@ pub struct RunSummary {
     pub title: String,
     /// Case file.
     pub case: String,
-    /// Solver that wrote the run: `peridynamics` or `fem` (run.json files without it: peridynamics).
+    /// Solver that wrote the run: `peridynamics` or `fem` (run.json files without it:
+    /// peridynamics).
     #[serde(default = "peridynamics")]
     pub solver: String,
     /// Body nodes.
@@ -373,7 +375,8 @@ pub struct RunSummary {
     pub steps: u64,
     /// Time step, s.
     pub dt: f64,
-    /// Stable bound on the step, s (0 for the FEM solver, whose schemes are unconditionally stable).
+    /// Stable bound on the step, s (0 for the FEM solver, whose schemes are unconditionally
+    /// stable).
     pub dt_stable: f64,
     /// Integrator.
     pub integrator: String,

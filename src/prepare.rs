@@ -183,7 +183,8 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
         Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
         Integrator::Euler | Integrator::Rk4 => None,
     };
-    // phase change: the enthalpy form of forward Euler (seed 001), refusing other integrators
+    // phase change: the enthalpy form of forward Euler (the axisymmetric phase-change paper,
+    // doi:10.1007/s42102-022-00092-3), refusing other integrators
     let enthalpic = match model.enthalpy {
         Some(_) => Some(Enthalpic::new(model, case.integrator).map_err(|e| keyed(case, e))?),
         None => None,

@@ -3,7 +3,7 @@
 //! On a lattice every interior row of K is the same stencil of offsets and conductances;
 //! only rows near faces, cracks or a change of spacing differ. Stored once per block of
 //! [`ROW_CHUNK`] rows, the stencils stay in cache and the explicit step streams 2 bytes per
-//! row instead of 12 bytes per bond (formulation §2: the same K, the same sums, bit for bit).
+//! row instead of 12 bytes per bond (theory §2: the same K, the same sums, bit for bit).
 //! Clouds without repeated rows (gmsh meshes) do not compress and keep the plain CSR.
 
 use crate::operator::{Conductance, ROW_CHUNK};

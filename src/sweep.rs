@@ -1,6 +1,6 @@
 //! Sweeps: variants of cases (over the horizon factor, the spacing, the mesh ratio k, the
 //! horizon ratio m, …) made by setting keys of the case file, run one after another, and
-//! compared with a reference (formulation §9): the case's own `[reference]`, another run, or
+//! compared with a reference (theory §9): the case's own `[reference]`, another run, or
 //! the first variant.
 
 use crate::case::{Case, ReferenceSource};
@@ -246,10 +246,10 @@ pub struct Row {
     pub max_abs: f64,
     /// Mean |θ − θ_ref| over the nodes compared, °C (field-to-field comparisons only).
     pub mean_abs: Option<f64>,
-    /// Seed 003 eq 13 along the case's probe line (classical references only).
+    /// Bobaru & Duangpanya 2012, eq. 13 along the case's probe line (classical references only).
     pub eq13: Option<f64>,
-    /// Seed 001 eq 27: rms difference / max |θ_ref| (the other run's field is the reference
-    /// when comparing with a run).
+    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
+    /// / max |θ_ref| (the other run's field is the reference when comparing with a run).
     pub epsilon: Option<f64>,
     /// Volume-weighted relative L2 error over all body nodes, ‖θ − θ_ref‖/‖θ_ref‖
     /// (classical references only), dimensionless.
@@ -524,8 +524,8 @@ fn plot_axes(rows: &[Row]) -> Vec<(String, Axis)> {
 
 /// Convergence plots of a sweep into `out`, one per output time: the max difference (and
 /// eq 13 and the relative L2 error where there are) against each axis of `plot_axes` along
-/// which the rows differ, on log–log axes with fitted rates (Bobaru & Duangpanya 2010 Figs 10–12, 2012
-/// Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
+/// which the rows differ, on log–log axes with fitted rates (Bobaru & Duangpanya 2010 Figs 10–12,
+/// 2012 Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
 pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
     let axes = plot_axes(rows);
     let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
@@ -609,7 +609,7 @@ pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String
 
 /// One line plot per output time and probe line with every variant's PD temperatures
 /// (markers) and the reference (a line: the first variant's reference column, or the run
-/// compared with), into `out/lines_<line>_t<k>` (seed 004 Figs 5–25: PD for several
+/// compared with), into `out/lines_<line>_t<k>` (Wang, Oterkus & Oterkus Figs 5–25: PD for several
 /// configurations against FEM). Returns the stems written.
 pub fn line_plots(
     variants: &[Variant],

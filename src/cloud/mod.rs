@@ -1,8 +1,9 @@
 //! Node clouds: struct-of-arrays storage and the built-in box generators.
 //!
 //! A cloud holds the body nodes first (`0..n_body`) and the fictitious boundary-layer
-//! nodes after them (seed 004 fictitious regions, seed 001 mirror/naive layers). Every
-//! node has its own spacing Δ and horizon δ, which is what dual horizon needs (seed 004 §3).
+//! nodes after them (the fictitious regions of Wang, Oterkus & Oterkus, the mirror/naive layers of
+//! the axisymmetric phase-change paper). Every node has its own spacing Δ and horizon δ, which is
+//! what dual horizon needs (Wang, Oterkus & Oterkus §3).
 
 pub mod facets;
 pub mod mesh;
@@ -39,7 +40,7 @@ pub struct Reflection {
     pub distance: f64,
 }
 
-/// Where a fictitious node takes its temperature from (formulation §3).
+/// Where a fictitious node takes its temperature from (theory §3).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Fictitious {
     /// A lattice node of a box geometry, outside the faces in the bit mask (bit f = face f).
@@ -107,9 +108,10 @@ pub struct Cloud {
     pub min: Point,
     /// Bounding box of the body: max corner, m.
     pub max: Point,
-    /// Whether nodes sit on the boundary with partial volumes (seed 003 §3).
+    /// Whether nodes sit on the boundary with partial volumes (Bobaru & Duangpanya 2012 §3).
     pub boundary_placement: bool,
-    /// Planar, or rings/shells about the axis x = 0 (seed 001, formulation §7).
+    /// Planar, or rings/shells about the axis x = 0 (the axisymmetric phase-change paper; theory
+    /// §7).
     pub symmetry: Symmetry,
 }
 
@@ -317,7 +319,7 @@ impl Cloud {
 /// How a region's horizon follows from its spacing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HorizonRule {
-    /// δ = n·Δ (seed 004 eq 27).
+    /// δ = n·Δ (Wang, Oterkus & Oterkus, eq. 27).
     Factor(f64),
     /// An explicit δ, m.
     Radius(f64),
@@ -372,7 +374,8 @@ pub struct BoxGeometry {
     pub min: [f64; 3],
     /// Domain max corner, m.
     pub max: [f64; 3],
-    /// Nodes on the boundary with partial volumes (seed 003 §3) instead of cell centres.
+    /// Nodes on the boundary with partial volumes (Bobaru & Duangpanya 2012 §3) instead of cell
+    /// centres.
     pub boundary_placement: bool,
     /// The regions; together they tile the domain.
     pub regions: Vec<BoxRegion>,

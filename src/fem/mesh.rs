@@ -107,7 +107,8 @@ impl FemMesh {
     }
 
     /// Weight of a quadrature point at `p` from the body's symmetry: 1 (planar), 2πr or 4πr²
-    /// with r = x (seed 001 ring and shell measures), m⁰, m or m².
+    /// with r = x (the ring and shell measures of the axisymmetric phase-change paper,
+    /// doi:10.1007/s42102-022-00092-3), m⁰, m or m².
     #[inline]
     pub fn symmetry_weight(&self, p: &Point) -> f64 {
         self.symmetry.volume_factor(p.x)

@@ -1,4 +1,4 @@
-//! Measures that compare a run with a classical solution (formulation §9), and the report
+//! Measures that compare a run with a classical solution (theory §9), and the report
 //! pages that show them ([`page`]).
 
 pub mod page;
@@ -89,8 +89,9 @@ fn classical_values(
 
 /// Compares the body temperatures `theta` with the classical ones `classical` (at the body
 /// nodes, from [`classical_at`]) at time `t`: over all nodes, along the probe line
-/// y = `line_y` (seed 003 eq 13; nodes within half a spacing) and at the body node nearest to
-/// the probe point, and the volume-weighted relative L2 error over all nodes. Nodes within
+/// y = `line_y` (Bobaru & Duangpanya 2012, eq. 13; nodes within half a spacing) and at the body
+/// node nearest to the probe point, and the volume-weighted relative L2 error over all nodes. Nodes
+/// within
 /// `spec.exclude_tips` of a point of `tips` are left out.
 pub fn compare(
     cloud: &Cloud,
@@ -186,15 +187,15 @@ pub struct FieldDifference {
 }
 
 impl FieldDifference {
-    /// Seed 001 eq 27 with B as the reference: ε = rms(θ_b − θ_a) / max |θ_b| (0 when B is
-    /// zero everywhere), dimensionless.
+    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27 with B as the
+    /// reference: ε = rms(θ_b − θ_a) / max |θ_b| (0 when B is zero everywhere), dimensionless.
     pub fn epsilon(&self) -> f64 {
         epsilon(self.rms, self.reference_max_abs)
     }
 }
 
-/// Seed 001 eq 27 from its two parts: ε = rms / max |T_ref| (0 when the reference is zero
-/// everywhere), dimensionless.
+/// The axisymmetric phase-change paper, eq. 27 from its two parts: ε = rms / max |T_ref| (0 when
+/// the reference is zero everywhere), dimensionless.
 pub fn epsilon(rms: f64, reference_max_abs: f64) -> f64 {
     if reference_max_abs > 0.0 {
         rms / reference_max_abs
@@ -300,10 +301,11 @@ mod tests {
     use super::*;
     use crate::analytic::Reference;
 
-    /// Seed 001 eq 27 by its definition: a field off the reference by the same d at every node
-    /// has rms d, so ε = d / max |T_ref| whatever the field; a difference at one node of N
-    /// gives rms d/√N. Both for `compare` (classical references) and `field_difference`
-    /// (runs: a linear reference field is interpolated exactly). Tolerance: round-off.
+    /// The axisymmetric phase-change paper, eq. 27 by its definition: a field off the reference by
+    /// the same d at every node has rms d, so ε = d / max |T_ref| whatever the field; a difference
+    /// at one node of N gives rms d/√N. Both for `compare` (classical references) and
+    /// `field_difference` (runs: a linear reference field is interpolated exactly). Tolerance:
+    /// round-off.
     #[test]
     fn epsilon_is_rms_over_reference_maximum() {
         let n = 11;

@@ -130,7 +130,8 @@ pub fn draw_maps(
     for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
         let cracks = segments_at(&cutters, *t);
         let several_regions = f.region.iter().any(|&r| r != f.region[0]);
-        // phase fronts: the isotherms at each phase-change temperature (seed 001 Fig. 13)
+        // phase fronts: the isotherms at each phase-change temperature (the axisymmetric
+        // phase-change paper Fig. 13)
         let fronts: Vec<[Point; 2]> = case
             .spec
             .materials
@@ -483,9 +484,9 @@ fn metrics(s: &RunSummary) -> Vec<[String; 6]> {
 const METRIC_HEADER: [&str; 6] = [
     "t (s)",
     "max abs diff (°C)",
-    "eq 45 (seed 000)",
-    "eq 13 (seed 003)",
-    "ε (seed 001 eq 27)",
+    "eq 45 (Bobaru & Duangpanya 2010)",
+    "eq 13 (Bobaru & Duangpanya 2012)",
+    "ε (eq 27, phase-change paper)",
     "probe PD / reference (°C)",
 ];
 

@@ -1,4 +1,5 @@
-//! Explicit time integration: forward Euler (seeds 001, 004) and classical RK4 (seeds 000, 003).
+//! Explicit time integration: forward Euler (Wang, Oterkus & Oterkus; the axisymmetric phase-change
+//! paper, doi:10.1007/s42102-022-00092-3) and classical RK4 (Bobaru & Duangpanya 2010, 2012).
 //!
 //! The rate of a free body node is `Σ_j K_ij (θ_j − θ_i)/(V_i ρc_i)` plus loads; driven nodes
 //! (Dirichlet, flux relations) and fictitious nodes are set by the boundary at every stage.
@@ -13,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
 /// Time integrator of `time.integrator`: the explicit ones here, the implicit ones and the
-/// steady solve in [`crate::solve::implicit`] (formulation §4).
+/// steady solve in [`crate::solve::implicit`] (theory §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Integrator {
@@ -47,7 +48,7 @@ impl Integrator {
     pub fn is_implicit(&self) -> bool {
         !matches!(self, Integrator::Euler | Integrator::Rk4)
     }
-    /// Stability-region extent on the negative real axis (formulation §4); infinite for the
+    /// Stability-region extent on the negative real axis (theory §4); infinite for the
     /// implicit schemes (A-stable).
     pub fn stability(&self) -> f64 {
         match self {

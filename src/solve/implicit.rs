@@ -1,9 +1,9 @@
 //! Implicit time integration (backward Euler, Crank–Nicolson, BDF2) and the steady-state solve
-//! of formulation §4 (beyond the papers) for linear materials.
+//! of theory §4 (beyond the papers) for linear materials.
 //!
-//! **The system on the body's free nodes.** Formulation eq (1) for the free body nodes is
+//! **The system on the body's free nodes.** Theory §2, eq. 1, for the free body nodes is
 //! `M_i dθ_i/dt = Σ_j K_ij (θ_j − θ_i) + M_i s_i`, M_i = V_i ρc_i. Every other node is
-//! constrained by the boundary (formulation §3): a fictitious node by its affine rule
+//! constrained by the boundary (theory §3): a fictitious node by its affine rule
 //! θ_f = σ·Σ w θ(mirror stencil) + Σ coef·g(t), a nodal-Dirichlet node by θ_b(t), a flux-relation
 //! node by an affine rule over body nodes. [`crate::bc::Boundary::linear_rules`] gives the linear
 //! part of those rules in the order the explicit solvers apply them; each is expanded
@@ -60,7 +60,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Implicit time-stepping scheme (formulation §4).
+/// Implicit time-stepping scheme (theory §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scheme {
     /// Backward Euler, first order, L-stable.
@@ -119,7 +119,7 @@ impl Default for Options {
 /// Relative asymmetry below which A is treated as symmetric (of the largest diagonal entry).
 pub const SYMMETRY_TOLERANCE: f64 = 1e-10;
 
-/// The semi-discrete system `M dθ/dt = −A θ + f(t)` on the free body nodes (formulation §4).
+/// The semi-discrete system `M dθ/dt = −A θ + f(t)` on the free body nodes (theory §4).
 #[derive(Debug, Clone)]
 pub struct System {
     /// Body node of each unknown.
@@ -1183,7 +1183,8 @@ impl<'a> Implicit<'a> {
                 Ok((self.estimate(), 2))
             }
             Scheme::BackwardEuler | Scheme::Bdf2 => {
-                // BDF2 (backward Euler took the first arm); θ(t − h): an accepted value or the Hermite interpolant of the last step
+                // BDF2 (backward Euler took the first arm); θ(t − h): an accepted value or the
+                // Hermite interpolant of the last step
                 let back = t - h;
                 let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * h;
                 if close(back, t_prev) {
@@ -1432,7 +1433,7 @@ impl<'a> Implicit<'a> {
     }
 
     /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
-    /// `on_output(k, t, θ, K)` for each (formulation §4).
+    /// `on_output(k, t, θ, K)` for each (theory §4).
     pub fn steady(
         &mut self,
         theta: &mut [f64],

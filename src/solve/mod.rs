@@ -1,4 +1,4 @@
-//! Time integration of formulation eq (1).
+//! Time integration of theory §2, eq. 1.
 
 pub mod enthalpy;
 pub mod explicit;

@@ -12,7 +12,7 @@
 //! Σ_j K'_ij ξ_ij = 0,       Σ_j K'_ij ξ_ij ⊗ ξ_ij = 2 k_i V_i I
 //! ```
 //!
-//! so that Σ_j K'_ij (θ_j − θ_i) = V_i k_i ∇²θ for every quadratic θ (formulation §2.1: the
+//! so that Σ_j K'_ij (θ_j − θ_i) = V_i k_i ∇²θ for every quadratic θ (theory §2.1: the
 //! 2D thickness and 1D cross-section are in V_i).
 //!
 //! Of all K' that meet these moments we take the one nearest to K in relative entropy,
