@@ -585,3 +585,66 @@ fn compare_and_plot_work_from_any_directory() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(err.contains("l.msh") && err.contains("changed"), "{err}");
 }
+
+/// docs/case-reference.md names every key of the case schema: each field of a struct that
+/// the case file is read into (`deny_unknown_fields` in src/case.rs, src/material.rs,
+/// src/analytic.rs) appears in backticks, alone or as the last part of a dotted key.
+#[test]
+fn the_case_reference_lists_every_schema_key() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/case-reference.md")).unwrap();
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for file in ["src/case.rs", "src/material.rs", "src/analytic.rs"] {
+        let text = std::fs::read_to_string(root.join(file)).unwrap();
+        for key in schema_keys(&text) {
+            checked += 1;
+            // a key (`key`, `section.key`) or a section (`[key]`, `[[key]]`, `[key.<name>]`)
+            let forms = [
+                format!("`{key}`"),
+                format!(".{key}`"),
+                format!("`[{key}]"),
+                format!("`[[{key}]]"),
+                format!("`[{key}."),
+            ];
+            if !forms.iter().any(|f| doc.contains(f.as_str())) {
+                missing.push(format!("{file}: {key}"));
+            }
+        }
+    }
+    assert!(
+        checked > 60,
+        "only {checked} keys found: the parser below missed the schema"
+    );
+    assert!(
+        missing.is_empty(),
+        "not in docs/case-reference.md: {missing:?}"
+    );
+}
+
+/// The serde names of the fields of every `deny_unknown_fields` struct in `text`.
+fn schema_keys(text: &str) -> Vec<String> {
+    let mut keys = Vec::new();
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if !line.contains("deny_unknown_fields") {
+            continue;
+        }
+        let mut rename = None;
+        for l in lines.by_ref() {
+            let l = l.trim();
+            if l.starts_with('}') {
+                break;
+            }
+            if let Some(r) = l.strip_prefix("#[serde(rename = \"") {
+                rename = r.split('"').next().map(str::to_string);
+            }
+            if let Some(field) = l.strip_prefix("pub ").and_then(|f| f.split_once(':')) {
+                if !field.0.contains(' ') && !field.0.contains('(') {
+                    keys.push(rename.take().unwrap_or_else(|| field.0.to_string()));
+                }
+            }
+        }
+    }
+    keys
+}
