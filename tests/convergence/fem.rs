@@ -2,12 +2,10 @@
 //! space against the analytical square and bar, the seed 003 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!
-//! `cargo test --release --test fem -- --nocapture` prints the measured figures quoted in the
-//! README.
+//! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
+//! quoted in the README.
 
-mod common;
-
-use common::fd::CrackPlate;
+use crate::common::fd::CrackPlate;
 use peritherm::case::Case;
 use peritherm::fem::run::FemModel;
 use peritherm::fem::shape::shape;
@@ -228,7 +226,7 @@ fn fem_at(model: &FemModel, theta: &[f64], nx: usize, a: f64, x: f64, y: f64) ->
 /// and 960² quads against FD on 960² cells, steady: 1.52, 1.02 and 0.67 °C next to a tip,
 /// 0.35, 0.23 and 0.17 °C beyond 1 mm of them; see `crack_plate_resolution_study`), so the
 /// bound of 0.5 °C is asserted outside the discs of radius 2δ = 2.17 mm around the tips, as
-/// the PD test in tests/cracks.rs does, and the differences everywhere and beyond 1 mm are
+/// the PD test in tests/cases/cracks.rs does, and the differences everywhere and beyond 1 mm are
 /// printed.
 #[test]
 fn crack_plate_matches_finite_differences() {
@@ -666,11 +664,11 @@ fn steady_linear_fields_and_loads_are_exact() {
     check("source", &m, &t, &|x| 50.0 * x * (2.0 - x) / 8.0);
 }
 
-/// Resolution study of the steady crack plate behind the README's figures (ignored: ~15 s;
-/// run with `cargo test --release --test fem -- --ignored --nocapture`): FEM on n² quads and
-/// FD on n² cells for n = 240, 480, 960, each compared with FD on 960² cells at the centres
-/// of the 240² cells (finer FD fields interpolated there from the 4 cells around the point),
-/// next to the tips and beyond 1 mm of them.
+/// Resolution study of the steady crack plate behind the README's figures (ignored: ~15 s; run
+/// with `cargo test --release --test convergence fem:: -- --ignored --nocapture`): FEM on n²
+/// quads and FD on n² cells for n = 240, 480, 960, each compared with FD on 960² cells at the
+/// centres of the 240² cells (finer FD fields interpolated there from the 4 cells around the
+/// point), next to the tips and beyond 1 mm of them.
 #[test]
 #[ignore]
 fn crack_plate_resolution_study() {

@@ -7,8 +7,7 @@ use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::PathBuf;
 
-mod common;
-use common::fd::CrackPlate;
+use crate::common::fd::CrackPlate;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

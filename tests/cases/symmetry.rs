@@ -3,7 +3,7 @@
 //! against its series, exact energy conservation of an insulated axisymmetric body, and the
 //! radial heat flux of seed 001 eq 25 against −k dθ/dr.
 //!
-//! `cargo test --release --test symmetry -- --nocapture` prints the measured figures.
+//! `cargo test --release --test cases symmetry:: -- --nocapture` prints the measured figures.
 
 use peritherm::case::Case;
 use peritherm::model::Model;
