@@ -1,7 +1,7 @@
 //! The command line as a user meets it: the output contract and bad input.
 
+use crate::common::cli::{peritherm, write_case};
 use std::path::Path;
-use std::process::Command;
 
 const SMALL: &str = r#"
 dimension = 2
@@ -41,19 +41,6 @@ const SPLIT: &str = "[reference.solution]\nkind = \"plate_pulse_split\"\nx0 = 0.
 
 /// A `film_laser_pulse` reference with a reflectivity above 1.
 const LASER: &str = "[reference.solution]\nkind = \"film_laser_pulse\"\nx0 = 0.0\nlength = 1.0\ndiffusivity = 1.5e-5\nheat_capacity = 3.3e6\nfluence = 13.4\nreflectivity = 1.5\ndepth = 0.1\nduration = 0.1\nshape = 2.0\n";
-
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn write_case(dir: &Path, name: &str, text: &str) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p.display().to_string()
-}
 
 /// field_<k>.csv has x,y,z,temperature and one row per body node; run.json has the keys.
 #[test]

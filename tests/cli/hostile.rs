@@ -234,7 +234,7 @@ fn an_interrupted_run_says_so_and_leaves_no_partial_file() {
         "end = 1e4\ndt = 1e-3\noutputs = [0.01, 0.02, 1e4]",
     );
     let case = write_case(dir.path(), "long.toml", &text);
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_peritherm"))
+    let mut child = crate::common::cli::command()
         .args([
             "run",
             case.to_str().unwrap(),

@@ -8,6 +8,7 @@
 
 #[path = "../common"]
 mod common {
+    pub mod cli;
     pub mod hostile;
 }
 

@@ -2,13 +2,13 @@
 //! size and an SVG with its labels, colours land where the values are, bad data is a typed
 //! error; and `peritherm plot` on small 2D and 3D runs.
 
+use crate::common::cli::peritherm;
 use peritherm::math::{Point, Vector};
 use peritherm::plot::{
     convergence_plot, field_map, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
 use peritherm::Error;
 use std::path::Path;
-use std::process::Command;
 
 /// Width and height from a PNG's IHDR chunk, after checking the signature.
 fn png_size(path: &Path) -> (u32, u32) {
@@ -249,14 +249,6 @@ value = 100.0
 end = 200.0
 outputs = [100.0, 200.0]
 "#;
-
-/// Runs the binary.
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 /// `peritherm plot` on a cracked 2D run writes temperature and damage maps per output; on a
 /// 3D run it points at the VTK files.

@@ -5,14 +5,14 @@
 //! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
 //! quoted in the README.
 
+use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
 use peritherm::case::Case;
 use peritherm::fem::run::FemModel;
 use peritherm::fem::shape::shape;
 use peritherm::fem::solve::{Scheme, Stepper};
 use peritherm::mesh::ElementKind;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -452,19 +452,6 @@ end = 0.1
     }
 }
 
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn write_case(dir: &Path, text: &str) -> String {
-    let p = dir.join("case.toml");
-    std::fs::write(&p, text).unwrap();
-    p.display().to_string()
-}
-
 /// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header
 /// (the reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver "fem", the reference
 /// comparison) that `peritherm table` reads.
@@ -473,6 +460,7 @@ fn cli_writes_the_run_contract() {
     let dir = tempfile::tempdir().unwrap();
     let case = write_case(
         dir.path(),
+        "case.toml",
         &SQUARE.replace("end = 0.05", "end = 0.05\noutputs = [0.01, 0.05]"),
     );
     let out = dir.path().join("out");
@@ -554,7 +542,7 @@ fn unsupported_cases_give_clear_errors() {
         ),
     ];
     for (text, extra, key, what) in cases {
-        let path = write_case(dir.path(), &text);
+        let path = write_case(dir.path(), "case.toml", &text);
         let out = dir.path().join("out");
         let mut args = vec!["fem", &path, "--out", out.to_str().unwrap()];
         args.extend(extra);
@@ -1152,6 +1140,7 @@ fn reference_fem_mesh_solves_on_another_mesh() {
     for (text, what) in bad {
         let path = PathBuf::from(write_case(
             dir.path(),
+            "case.toml",
             &text.replace("\"../meshes/", &meshes),
         ));
         let o = peritherm(&[
