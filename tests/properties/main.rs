@@ -7,6 +7,11 @@
 //! Run this group with `cargo test --release --test properties`, one file of it with a
 //! filter, e.g. `cargo test --release --test properties weights::`.
 
+#[path = "../common"]
+mod common {
+    pub mod case;
+}
+
 mod boundary;
 mod gmsh;
 mod mesh;

@@ -3,11 +3,10 @@
 //! still stable. The meshes are meshes/moments_*.msh (triangles, unstructured quadrangles,
 //! mixed, graded 4×, tetrahedra; the hexahedra of moments_hex.msh are the open case below).
 
-use peritherm::case::Case;
+use crate::common::case::CaseToml;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::weights::Order;
-use std::path::Path;
 
 const MESHES: [(&str, usize); 5] = [
     ("moments_tri.msh", 2),
@@ -20,30 +19,15 @@ const MESHES: [(&str, usize); 5] = [
 /// A case on `file` with conductivity 2, the wall given `wall` (a TOML table body).
 fn model(file: &str, dim: usize, wall: &str, initial: &str, order: Option<&str>) -> Model {
     let consistency = order.map_or(String::new(), |o| format!("consistency = \"{o}\"\n"));
-    let text = format!(
-        r#"
-dimension = {dim}
-[mesh]
-file = "../meshes/{file}"
-[[region]]
-name = "body"
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 2.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-{consistency}
-[boundary.wall]
-{wall}
-[initial]
-value = "{initial}"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    let case = Case::parse(&text, Path::new("tests/weights.toml")).unwrap();
+    let case = CaseToml::new(dim)
+        .mesh(&format!("../meshes/{file}"))
+        .region("body", "", 3.0)
+        .material("m", 2.0, 1.0, 1.0)
+        .section(&format!("[kernel]\n{consistency}"))
+        .section(&format!("[boundary.wall]\n{wall}"))
+        .initial(initial)
+        .time_key("integrator = \"euler\"")
+        .case("tests/weights.toml");
     Model::build(&case.spec).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 
