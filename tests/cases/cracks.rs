@@ -7,14 +7,16 @@ use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::PathBuf;
 
+use crate::common::case::CaseToml;
 use crate::common::fd::CrackPlate;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn case(text: &str) -> Case {
-    Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+/// Where the test cases pretend to live (relative paths in them resolve from `cases/`).
+fn in_cases() -> PathBuf {
+    root().join("cases/test.toml")
 }
 
 /// The body node at (x, y, z) (within 1e-9 m).
@@ -35,35 +37,24 @@ fn run_steps(model: &Model, steps: usize, dt: f64) -> Vec<f64> {
     theta
 }
 
+/// The unit square (Δ = 0.02, δ = 3Δ), k = ρc = 1, with an explicit Euler time loop.
+fn unit_square() -> CaseToml {
+    CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 1.0]")
+        .region("r", "spacing = 0.02", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .time_key("integrator = \"euler\"")
+}
+
 fn halves(conductance: f64, correction: bool) -> (f64, f64, f64) {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.02
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-crack_correction = {correction}
-[[crack]]
-points = [[-0.5, 0.5003], [0.4, 0.5003], [1.5, 0.5003]]
-conductance = {conductance}
-[initial]
-value = "y > 0.5"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    let c = case(&text);
-    let model = Model::build(&c.spec).unwrap();
+    let model = unit_square()
+        .section(&format!(
+            "[kernel]\ncrack_correction = {correction}\n\
+             [[crack]]\npoints = [[-0.5, 0.5003], [0.4, 0.5003], [1.5, 0.5003]]\n\
+             conductance = {conductance}"
+        ))
+        .initial("y > 0.5")
+        .model(in_cases());
     let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
     let theta = run_steps(&model, 500, dt);
     let energy_of = |th: &[f64], upper: bool| -> f64 {
@@ -94,27 +85,6 @@ fn an_insulated_crack_splits_the_body() {
     }
 }
 
-const LINEAR: &str = r#"
-dimension = DIM
-[domain]
-min = MIN
-max = MAX
-[[region]]
-name = "r"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.m]
-conductivity = 2.5
-density = 1.0
-specific_heat = 1.0
-[kernel]
-calibration = "lattice"
-[initial]
-value = "3 + 2*x - 5*y + 7*z"
-[time]
-end = 1.0
-"#;
-
 /// The PD heat flux (formulation §8) equals −k∇θ for a linear field at every bulk node
 /// (horizon clear of the free faces), in 2D and 3D. Tolerance 1e-10 relative: with the
 /// lattice calibration the half-horizon moment is k exactly, leaving round-off.
@@ -124,11 +94,13 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
         (2, "[0.0, 0.0]", "[1.0, 1.0]"),
         (3, "[0.0, 0.0, 0.0]", "[0.5, 0.5, 0.5]"),
     ] {
-        let text = LINEAR
-            .replace("DIM", &dim.to_string())
-            .replace("MIN", min)
-            .replace("MAX", max);
-        let model = Model::build(&case(&text).spec).unwrap();
+        let model = CaseToml::new(dim)
+            .domain(min, max)
+            .region("r", "spacing = 0.05", 3.0)
+            .material("m", 2.5, 1.0, 1.0)
+            .section("[kernel]\ncalibration = \"lattice\"")
+            .initial("3 + 2*x - 5*y + 7*z")
+            .model(in_cases());
         let q = model.conductance.flux(&model.cloud, &model.theta0);
         let grad = [2.0, -5.0, if dim == 3 { 7.0 } else { 0.0 }];
         let c = &model.cloud;
@@ -292,38 +264,19 @@ fn crack_plate_matches_finite_differences() {
     }
 }
 
-const GROWING: &str = r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.02
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[0.0, 0.5003], [0.6, 0.5003], [1.0, 0.5003]]
-speed = 0.1
-start = 0.2
-initial_length = 0.1
-[initial]
-value = "y > 0.5"
-[time]
-end = 1.0
-integrator = "euler"
-"#;
-
 /// A growing crack cuts each pair when its tip passes the crossing point: at
 /// start + (x_cross − initial_length)/speed, pairs crossing the initial length at once,
 /// pairs the tip never reaches never. The stepper cuts them in place at that moment, K
 /// stays symmetric, and energy is conserved to round-off across the cuts.
 #[test]
 fn growing_crack_cuts_bonds_when_its_tip_passes() {
-    let model = Model::build(&case(GROWING).spec).unwrap();
+    let model = unit_square()
+        .section(
+            "[[crack]]\npoints = [[0.0, 0.5003], [0.6, 0.5003], [1.0, 0.5003]]\n\
+             speed = 0.1\nstart = 0.2\ninitial_length = 0.1",
+        )
+        .initial("y > 0.5")
+        .model(in_cases());
     let c = &model.cloud;
     assert!(!model.growth.is_empty());
     let k0 = &model.conductance;
@@ -392,25 +345,15 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
 /// and zero beside it, and a node pair straddling it has K = 0.
 #[test]
 fn a_planar_polygon_cuts_3d_bonds() {
-    let text = r#"
-dimension = 3
-[domain]
-min = [0.0, 0.0, 0.0]
-max = [1.0, 1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.1
-horizon = { factor = 2 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]
-[time]
-end = 1.0
-"#;
-    let model = Model::build(&case(text).spec).unwrap();
+    let cube = |points: &str| {
+        CaseToml::new(3)
+            .domain("[0.0, 0.0, 0.0]", "[1.0, 1.0, 1.0]")
+            .region("r", "spacing = 0.1", 2.0)
+            .material("m", 1.0, 1.0, 1.0)
+            .section(&format!("[[crack]]\npoints = {points}"))
+    };
+    let model = cube("[[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]")
+        .model(in_cases());
     let find = |x: f64, y: f64, z: f64| node_at(&model, x, y, z);
     let (a, b) = (find(0.35, 0.45, 0.45), find(0.35, 0.45, 0.55));
     assert_eq!(model.conductance.get(a, b), 0.0);
@@ -419,8 +362,8 @@ end = 1.0
     let d = model.damage_at(0.0);
     assert!(d[a] > 0.2, "damage {}", d[a]);
     assert_eq!(d[a2], 0.0);
-    let bad = text.replace("[0.2, 0.6, 0.5]]", "[0.2, 0.6, 0.7]]");
-    let e = Case::parse(&bad, &root().join("cases/test.toml"))
+    let bad = cube("[[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.7]]");
+    let e = Case::parse(&bad.text(), &in_cases())
         .unwrap_err()
         .to_string();
     assert!(e.contains("crack[0].points") && e.contains("planar"), "{e}");

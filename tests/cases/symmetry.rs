@@ -5,15 +5,15 @@
 //!
 //! `cargo test --release --test cases symmetry:: -- --nocapture` prints the measured figures.
 
+use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
 
-fn case(text: &str) -> Case {
-    Case::parse(text, Path::new("symmetry.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
+/// The kernel of every test here: constant p = 2 profile, lattice calibration.
+const KERNEL: &str = "[kernel]\np = 2\ncalibration = \"lattice\"";
 
 /// The steady state of `c` (one SPD solve with the boundary values at t = 1).
 fn steady(c: &Case) -> (Model, Vec<f64>) {
@@ -48,40 +48,20 @@ fn wall(symmetry: &str, dim: usize, dx: f64) -> Case {
             "[boundary.y_min]\ntype = \"insulated\"\n[boundary.y_max]\ntype = \"insulated\"\n",
         )
     };
-    case(&format!(
-        r#"
-dimension = {dim}
-symmetry = "{symmetry}"
-[domain]
-min = {min}
-max = {max}
-[[region]]
-name = "wall"
-spacing = {dx}
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 4.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = 100.0
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 0.0
-{z}
-[initial]
-value = 0.0
-[time]
-end = 1.0
-integrator = "steady"
-"#
-    ))
+    CaseToml::new(dim)
+        .key(&format!("symmetry = \"{symmetry}\""))
+        .domain(min, max)
+        .region("wall", &format!("spacing = {dx}"), 3.0)
+        .material("m", 4.0, 1.0, 1.0)
+        .section(KERNEL)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 100.0\n\
+             [boundary.x_max]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 0.0",
+        )
+        .section(z)
+        .initial_value(0.0)
+        .time_key("integrator = \"steady\"")
+        .case("symmetry.toml")
 }
 
 /// An exact radial profile θ(r), °C.
@@ -203,42 +183,21 @@ fn sphere_cools_as_the_series() {
     let times = [2.0, 5.0, 10.0];
     let mut eps: Vec<Vec<f64>> = Vec::new();
     for n in [20.0, 40.0, 80.0] {
-        let c = case(&format!(
-            r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [0.1]
-[[region]]
-name = "sphere"
-spacing = {}
-horizon = {{ factor = 3 }}
-[material.copper]
-conductivity = 400.0
-density = 8920.0
-specific_heat = 385.0
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 300.0
-[initial]
-value = 1000.0
-[time]
-end = 10.0
-integrator = "euler"
-[reference.solution]
-kind = "sphere_fixed_surface"
-radius = 0.1
-diffusivity = {alpha:e}
-surface = 300.0
-initial = 1000.0
-"#,
-            0.1 / n
-        ));
+        let c = CaseToml::new(1)
+            .key("symmetry = \"spherical\"")
+            .domain("[0.0]", "[0.1]")
+            .region("sphere", &format!("spacing = {}", 0.1 / n), 3.0)
+            .material("copper", 400.0, 8920.0, 385.0)
+            .section(KERNEL)
+            .section("[boundary.x_max]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 300.0")
+            .section(&format!(
+                "[reference.solution]\nkind = \"sphere_fixed_surface\"\nradius = 0.1\n\
+                 diffusivity = {alpha:e}\nsurface = 300.0\ninitial = 1000.0"
+            ))
+            .initial_value(1000.0)
+            .end(10.0)
+            .time_key("integrator = \"euler\"")
+            .case("symmetry.toml");
         let model = Model::build(&c.spec).unwrap();
         let dt = 0.9 * choose_dt(&model, Integrator::Euler, None).unwrap() / 0.95;
         let series = match &c.reference.as_ref().unwrap().source {
@@ -288,37 +247,19 @@ initial = 1000.0
 /// its ghost sits at another radius than its image, so K_ig differs from the mirrored pair.)
 #[test]
 fn insulated_axisymmetric_body_conserves_energy() {
-    let c = case(
-        r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-[[region]]
-name = "body"
-spacing = 0.025
-horizon = { factor = 3 }
-[material.m]
-conductivity = 2.0
-density = 300.0
-specific_heat = 0.5
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.y_min]
-type = "insulated"
-method = "mirror"
-[boundary.y_max]
-type = "insulated"
-method = "mirror"
-[initial]
-value = "100*sin(7*x)*cos(5*y) + 20*x*y + 50"
-[time]
-end = 1.0
-integrator = "euler"
-"#,
-    );
+    let c = CaseToml::new(2)
+        .key("symmetry = \"axisymmetric\"")
+        .domain("[0.0, 0.0]", "[1.0, 0.5]")
+        .region("body", "spacing = 0.025", 3.0)
+        .material("m", 2.0, 300.0, 0.5)
+        .section(KERNEL)
+        .section(
+            "[boundary.y_min]\ntype = \"insulated\"\nmethod = \"mirror\"\n\
+             [boundary.y_max]\ntype = \"insulated\"\nmethod = \"mirror\"",
+        )
+        .initial("100*sin(7*x)*cos(5*y) + 20*x*y + 50")
+        .time_key("integrator = \"euler\"")
+        .case("symmetry.toml");
     let model = Model::build(&c.spec).unwrap();
     for integ in [Integrator::Euler, Integrator::Rk4] {
         let dt = choose_dt(&model, integ, None).unwrap();
