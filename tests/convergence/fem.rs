@@ -5,6 +5,7 @@
 //! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
 //! quoted in the README.
 
+use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
 use peritherm::case::Case;
@@ -18,8 +19,24 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Where the test cases pretend to live (relative paths in them resolve from `cases/`).
+fn in_cases() -> PathBuf {
+    root().join("cases/test.toml")
+}
+
 fn case(text: &str) -> Case {
-    Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+    Case::parse(text, &in_cases()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The refined crack plate mesh (2 × 2 cm, τ = 0.1 mm, δ = 3Δ), k = 114, ρc = 1e6, with no
+/// crack, initial field or time yet.
+fn refined_plate() -> CaseToml {
+    CaseToml::new(2)
+        .mesh("../meshes/crack_plate_refined.msh")
+        .mesh_key("thickness = 1e-4")
+        .region("zone", "", 3.0)
+        .region("far", "", 3.0)
+        .material("plate", 114.0, 1e6, 1.0)
 }
 
 /// The case's analytical reference series.
@@ -126,45 +143,24 @@ fn square_converges_at_second_order() {
     );
 }
 
-const BAR: &str = r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [10.0]
-[[region]]
-name = "bar"
-spacing = 0.5
-horizon = { factor = 3 }
-[material.paper]
-conductivity = 1.14
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = 0.0
-[boundary.x_max]
-type = "temperature"
-value = 0.0
-[initial]
-value = 100.0
-[time]
-end = 4.0
-[reference.solution]
-kind = "bar_fixed_ends"
-x0 = 0.0
-length = 10.0
-diffusivity = 1.14
-left = 0.0
-right = 0.0
-initial = 100.0
-"#;
-
 /// Seed 000 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0 °C) at
 /// t = 4 s on linear elements of h = L/10, L/20, L/40, L/80: rate ≥ 1.8 between every pair.
 /// Crank–Nicolson with Δt = 1e-3 s (time error ~1e-7 °C, far below the spatial ~1e-3 °C).
 #[test]
 fn bar_converges_at_second_order() {
-    let c = case(BAR);
+    let c = CaseToml::new(1)
+        .domain("[0.0]", "[10.0]")
+        .region("bar", "spacing = 0.5", 3.0)
+        .material("paper", 1.14, 1.0, 1.0)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nvalue = 0.0\n\
+             [boundary.x_max]\ntype = \"temperature\"\nvalue = 0.0\n\
+             [reference.solution]\nkind = \"bar_fixed_ends\"\nx0 = 0.0\nlength = 10.0\n\
+             diffusivity = 1.14\nleft = 0.0\nright = 0.0\ninitial = 100.0",
+        )
+        .initial_value(100.0)
+        .end(4.0)
+        .case(in_cases());
     let errors: Vec<f64> = [10.0, 20.0, 40.0, 80.0]
         .iter()
         .map(|n| max_error(&c, 10.0 / n, 4.0, 4000))
@@ -289,145 +285,48 @@ fn crack_plate_matches_finite_differences() {
 /// capacities are ring and shell volumes.
 #[test]
 fn insulated_bodies_conserve_energy() {
-    let texts = [
-        r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "100*sin(7*x)*cos(3*y) + 20"
-[time]
-end = 0.5
-"#
-        .to_string(),
-        r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "100*sin(7*x) + 20"
-[time]
-end = 0.5
-"#
-        .to_string(),
-        r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "a"
-max = [0.3]
-spacing = 0.05
-horizon = { factor = 3 }
-material = "x"
-[[region]]
-name = "b"
-min = [0.3]
-spacing = 0.1
-horizon = { factor = 3 }
-material = "y"
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[material.y]
-conductivity = 0.5
-density = 1.0
-specific_heat = 1.0
-[initial]
-value = "100*sin(7*x) + 20"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-thickness = 0.1
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[[crack]]
-points = [[0.2, 0.25], [0.7, 0.25], [0.7, 0.4]]
-[initial]
-value = "y > 0.25"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 3
-[domain]
-min = [0.0, 0.0, 0.0]
-max = [1.0, 0.5, 0.5]
-[[region]]
-name = "a"
-spacing = 0.1
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "x*y + 10*z"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 2
-[mesh]
-file = "../meshes/crack_plate_refined.msh"
-thickness = 1e-4
-[[region]]
-name = "zone"
-horizon = { factor = 3 }
-[[region]]
-name = "far"
-horizon = { factor = 3 }
-[material.plate]
-conductivity = 114.0
-density = 1e6
-specific_heat = 1.0
-[[crack]]
-group = "crack"
-[initial]
-value = "100*(y > 0)"
-[time]
-end = 0.1
-"#
-        .to_string(),
+    // k = 2, ρ = 3, c = 5
+    let x = |c: CaseToml| c.material("x", 2.0, 3.0, 5.0);
+    let cases = [
+        x(CaseToml::new(2)
+            .key("symmetry = \"axisymmetric\"")
+            .domain("[0.0, 0.0]", "[1.0, 0.5]")
+            .region("a", "spacing = 0.05", 3.0))
+        .initial("100*sin(7*x)*cos(3*y) + 20")
+        .end(0.5),
+        x(CaseToml::new(1)
+            .key("symmetry = \"spherical\"")
+            .domain("[0.0]", "[1.0]")
+            .region("a", "spacing = 0.05", 3.0))
+        .initial("100*sin(7*x) + 20")
+        .end(0.5),
+        x(CaseToml::new(1)
+            .domain("[0.0]", "[1.0]")
+            .region("a", "spacing = 0.05", 3.0)
+            .region_key("max = [0.3]")
+            .region_key("material = \"x\"")
+            .region("b", "spacing = 0.1", 3.0)
+            .region_key("min = [0.3]")
+            .region_key("material = \"y\""))
+        .material("y", 0.5, 1.0, 1.0)
+        .initial("100*sin(7*x) + 20"),
+        x(CaseToml::new(2)
+            .domain("[0.0, 0.0]", "[1.0, 0.5]")
+            .domain_key("thickness = 0.1")
+            .region("a", "spacing = 0.05", 3.0))
+        .section("[[crack]]\npoints = [[0.2, 0.25], [0.7, 0.25], [0.7, 0.4]]")
+        .initial("y > 0.25"),
+        x(CaseToml::new(3)
+            .domain("[0.0, 0.0, 0.0]", "[1.0, 0.5, 0.5]")
+            .region("a", "spacing = 0.1", 3.0))
+        .initial("x*y + 10*z"),
+        refined_plate()
+            .section("[[crack]]\ngroup = \"crack\"")
+            .initial("100*(y > 0)")
+            .end(0.1),
     ];
-    for text in &texts {
-        let c = case(text);
+    for case in &cases {
+        let c = case.case(in_cases());
         let model = FemModel::build(&c, None).unwrap();
         let e0 = model.energy(&model.theta0);
         let theta = integrate(&model, Scheme::BackwardEuler, c.end, 20);
@@ -610,16 +509,16 @@ fn steady_linear_fields_and_loads_are_exact() {
             2 => ("[0.0, 0.0]", "[2.0, 1.0]"),
             _ => ("[0.0, 0.0, 0.0]", "[2.0, 1.0, 0.5]"),
         };
-        let extent = if dim == 2 {
-            "thickness = 0.3"
+        let mut c = CaseToml::new(dim).domain(min, max);
+        if dim == 2 {
+            c = c.domain_key("thickness = 0.3");
         } else if dim == 1 {
-            "area = 0.3"
-        } else {
-            ""
-        };
-        format!(
-            "dimension = {dim}\n[domain]\nmin = {min}\nmax = {max}\n{extent}\n[[region]]\nname = \"r\"\nspacing = 0.25\nhorizon = {{ factor = 3 }}\n[material.m]\nconductivity = 4.0\ndensity = 1.0\nspecific_heat = 1.0\n{faces}\n[time]\nend = 1.0\n"
-        )
+            c = c.domain_key("area = 0.3");
+        }
+        c.region("r", "spacing = 0.25", 3.0)
+            .material("m", 4.0, 1.0, 1.0)
+            .section(faces)
+            .text()
     };
     let check = |what: &str, model: &FemModel, theta: &[f64], exact: &dyn Fn(f64) -> f64| {
         let worst = model
@@ -723,27 +622,13 @@ fn crack_plate_resolution_study() {
 /// the nodes its physical group does.
 #[test]
 fn cracks_split_what_they_should() {
-    let text = r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]
-[initial]
-value = "(y > 0.6) * 100"
-[time]
-end = 1.0
-"#;
-    let c = case(text);
+    let c = CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 1.0]")
+        .region("r", "spacing = 0.05", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .section("[[crack]]\npoints = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]")
+        .initial("(y > 0.6) * 100")
+        .case(in_cases());
     let model = FemModel::build(&c, None).unwrap();
     let theta = integrate(&model, Scheme::BackwardEuler, 1.0, 50);
     let upper = |p: &peritherm::math::Point, cell_centre_y: f64| {
@@ -791,29 +676,11 @@ end = 1.0
     assert!(moved > 1.0, "heat moves inside the upper half");
 
     let gmsh = |crack: &str| {
-        let text = format!(
-            r#"
-dimension = 2
-[mesh]
-file = "../meshes/crack_plate_refined.msh"
-thickness = 1e-4
-[[region]]
-name = "zone"
-horizon = {{ factor = 3 }}
-[[region]]
-name = "far"
-horizon = {{ factor = 3 }}
-[material.plate]
-conductivity = 114.0
-density = 1e6
-specific_heat = 1.0
-[[crack]]
-{crack}
-[time]
-end = 0.1
-"#
-        );
-        FemModel::build(&case(&text), None).unwrap().split_nodes
+        let c = refined_plate()
+            .section(&format!("[[crack]]\n{crack}"))
+            .end(0.1)
+            .case(in_cases());
+        FemModel::build(&c, None).unwrap().split_nodes
     };
     let by_group = gmsh("group = \"crack\"");
     let by_points = gmsh("points = [[-0.005, 0.0], [0.005, 0.0]]");
@@ -850,35 +717,18 @@ fn crank_nicolson_start_damps_the_initial_jump() {
 /// error ~1e-7 °C, far below the spatial one).
 #[test]
 fn time_dependent_held_end_converges_at_second_order() {
-    let text = r#"
-dimension = 1
-[domain]
-min = [-5.0]
-max = [5.0]
-[[region]]
-name = "bar"
-spacing = 0.5
-horizon = { factor = 3 }
-[material.unit]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = "5*t*exp(-2*t)"
-[boundary.x_max]
-type = "insulated"
-[time]
-end = 3.0
-[reference.solution]
-kind = "bar_pulse_left"
-x0 = -5.0
-length = 10.0
-diffusivity = 1.0
-amplitude = 5.0
-rate = 2.0
-"#;
-    let c = case(text);
+    let c = CaseToml::new(1)
+        .domain("[-5.0]", "[5.0]")
+        .region("bar", "spacing = 0.5", 3.0)
+        .material("unit", 1.0, 1.0, 1.0)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nvalue = \"5*t*exp(-2*t)\"\n\
+             [boundary.x_max]\ntype = \"insulated\"\n\
+             [reference.solution]\nkind = \"bar_pulse_left\"\nx0 = -5.0\nlength = 10.0\n\
+             diffusivity = 1.0\namplitude = 5.0\nrate = 2.0",
+        )
+        .end(3.0)
+        .case(in_cases());
     let errors: Vec<f64> = [20.0, 40.0, 80.0]
         .iter()
         .map(|n| max_error(&c, 10.0 / n, 3.0, 3000))
@@ -927,9 +777,14 @@ fn radial(symmetry: &str, dim: usize, faces: &str) -> String {
     } else {
         ("[0.5, 0.0]", "[1.0, 0.25]")
     };
-    format!(
-        "dimension = {dim}\nsymmetry = \"{symmetry}\"\n[domain]\nmin = {min}\nmax = {max}\n[[region]]\nname = \"r\"\nspacing = 0.05\nhorizon = {{ factor = 3 }}\n[material.m]\nconductivity = 4.0\ndensity = 1.0\nspecific_heat = 1.0\n{faces}\n[initial]\nvalue = 0.0\n[time]\nend = 1.0\n"
-    )
+    CaseToml::new(dim)
+        .key(&format!("symmetry = \"{symmetry}\""))
+        .domain(min, max)
+        .region("r", "spacing = 0.05", 3.0)
+        .material("m", 4.0, 1.0, 1.0)
+        .section(faces)
+        .initial_value(0.0)
+        .text()
 }
 
 /// Steady radial conduction with exact solutions, on elements of h = 1/20 … 1/160 of the
@@ -1006,35 +861,6 @@ fn symmetric_steady_states_converge_at_second_order() {
     }
 }
 
-const SPHERE: &str = r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [0.1]
-[[region]]
-name = "ball"
-spacing = 0.01
-horizon = { factor = 3 }
-[material.copper]
-conductivity = 400.0
-density = 8920.0
-specific_heat = 385.0
-[boundary.x_max]
-type = "temperature"
-value = 300.0
-[initial]
-value = 1000.0
-[time]
-end = 10.0
-[reference.solution]
-kind = "sphere_fixed_surface"
-radius = 0.1
-diffusivity = 1.1647e-4
-surface = 300.0
-initial = 1000.0
-"#;
-
 /// Seed 001 §3.2 (copper sphere R = 0.1 m, θ0 = 1000 K, surface held at 300 K, centre free)
 /// at t = 10 s on linear elements of h = R/40 … R/320 (3-point Gauss: 4πr² N_a N_b is of
 /// degree 4) against the series of `analytic::sphere_fixed_surface` (exact diffusivity
@@ -1049,7 +875,19 @@ initial = 1000.0
 fn sphere_converges_at_second_order() {
     const STEPS: usize = 4000;
     let alpha = 400.0 / (8920.0 * 385.0);
-    let c = case(&SPHERE.replace("1.1647e-4", &format!("{alpha:e}")));
+    let c = CaseToml::new(1)
+        .key("symmetry = \"spherical\"")
+        .domain("[0.0]", "[0.1]")
+        .region("ball", "spacing = 0.01", 3.0)
+        .material("copper", 400.0, 8920.0, 385.0)
+        .section(&format!(
+            "[boundary.x_max]\ntype = \"temperature\"\nvalue = 300.0\n\
+             [reference.solution]\nkind = \"sphere_fixed_surface\"\nradius = 0.1\n\
+             diffusivity = {alpha:e}\nsurface = 300.0\ninitial = 1000.0"
+        ))
+        .initial_value(1000.0)
+        .end(10.0)
+        .case(in_cases());
     let r = analytic(&c);
     let (mut bulk, mut centre) = (Vec::new(), Vec::new());
     for n in [40.0, 80.0, 160.0, 320.0] {

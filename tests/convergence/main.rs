@@ -10,6 +10,7 @@
 
 #[path = "../common"]
 mod common {
+    pub mod case;
     pub mod cli;
     pub mod fd;
     pub mod heat_fd;
