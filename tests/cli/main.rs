@@ -8,6 +8,7 @@
 
 #[path = "../common"]
 mod common {
+    pub mod case;
     pub mod cli;
     pub mod hostile;
 }
