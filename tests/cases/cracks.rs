@@ -1,5 +1,5 @@
-//! Cracks: bond cutting, damage, the heat-flux vector, and the seed 003 crack plate against
-//! an independent finite-difference solution.
+//! Cracks: bond cutting, damage, the heat-flux vector, and the Bobaru & Duangpanya 2012 crack plate
+//! against an independent finite-difference solution.
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
 use peritherm::case::Case;
@@ -85,7 +85,7 @@ fn an_insulated_crack_splits_the_body() {
     }
 }
 
-/// The PD heat flux (formulation §8) equals −k∇θ for a linear field at every bulk node
+/// The PD heat flux (theory §8) equals −k∇θ for a linear field at every bulk node
 /// (horizon clear of the free faces), in 2D and 3D. Tolerance 1e-10 relative: with the
 /// lattice calibration the half-horizon moment is k exactly, leaving round-off.
 #[test]
@@ -128,24 +128,23 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
     }
 }
 
-/// The bundled seed 003 Example 3 crack plate (with the crack correction) against the
-/// classical solution of the same problem (finite differences on 3 × 3 cells per PD node, so
-/// that every node sits on a cell centre; `common::fd`), at every node outside the 2δ discs
-/// around the crack tips:
+/// The bundled Bobaru & Duangpanya 2012 Example 3 crack plate (with the crack correction) against
+/// the classical solution of the same problem (finite differences on 3 × 3 cells per PD node, so
+/// that every node sits on a cell centre; `common::fd`), at every node outside the 2δ discs around
+/// the crack tips:
 /// - at 0.5 s against the classical transient at 0.5 s: within 1 °C (measured 0.45 °C);
 /// - run on to its steady state (3 s) against the classical steady solution: within 1 °C
 ///   (measured 0.48 °C; without the crack correction 2.22 °C, beside the crack faces).
 ///
-/// The 1 °C bound is about twice the PD discretisation error at δ = 13L/240 (seed 003's
-/// own figures show differences of this size against ABAQUS). The paper calls 0.5 s
-/// steady; it is not quite: the classical solution itself still moves by more than 2 °C
-/// between 0.5 s and its steady state at the middle of the crack faces, which this test also
-/// checks so that the transient-to-transient comparison stays justified.
-/// The gmsh refined-zone crack plate (cases/crack_plate_refined.toml: default triangles,
-/// consistent bond weights, crack correction) against the classical solution at 0.5 s
-/// (finite differences as above) outside the 2δ discs around the crack tips (δ = 3 × 1.25e-4
-/// m there): within 0.5 °C (the lattice plates are within 0.47–0.76 °C; this mesh was
-/// 1.07 °C with the kernel's own weights). Measured 0.234 °C.
+/// The 1 °C bound is about twice the PD discretisation error at δ = 13L/240 (Bobaru & Duangpanya
+/// 2012's own figures show differences of this size against ABAQUS). The paper calls 0.5 s steady;
+/// it is not quite: the classical solution itself still moves by more than 2 °C between 0.5 s and
+/// its steady state at the middle of the crack faces, which this test also checks so that the
+/// transient-to-transient comparison stays justified. The gmsh refined-zone crack plate
+/// (cases/crack_plate_refined.toml: default triangles, consistent bond weights, crack correction)
+/// against the classical solution at 0.5 s (finite differences as above) outside the 2δ discs
+/// around the crack tips (δ = 3 × 1.25e-4 m there): within 0.5 °C (the lattice plates are within
+/// 0.47–0.76 °C; this mesh was 1.07 °C with the kernel's own weights). Measured 0.234 °C.
 ///
 /// Triangle centroids do not sit on finite-difference cell centres, so the reference is
 /// interpolated bilinearly between cell centres (never across the crack). Taking the nearest
@@ -369,13 +368,13 @@ fn a_planar_polygon_cuts_3d_bonds() {
     assert!(e.contains("crack[0].points") && e.contains("planar"), "{e}");
 }
 
-/// Seed 004 §4.3: the dual-horizon crack plate with a coarse outer region ((k, m) = (2, 1),
-/// 25000 nodes) agrees with the classical solution at 0.5 s (finite differences, bilinear
-/// between cell centres, never across the crack) as well as the uniform fine run ((1, 1),
-/// 40000 nodes) does, outside the 2δ discs around the crack tips: both within 1 °C
-/// (measured 0.38 and 0.37 °C, the PD discretisation at δ = 3Δ beside the crack faces; the
-/// bound is the one of `crack_plate_matches_finite_differences`), and within 0.2 °C of each
-/// other (measured 0.09 °C, at the region interface).
+/// Wang, Oterkus & Oterkus (dual-horizon paper) §4.3: the dual-horizon crack plate with a coarse
+/// outer region ((k, m) = (2, 1), 25000 nodes) agrees with the classical solution at 0.5 s (finite
+/// differences, bilinear between cell centres, never across the crack) as well as the uniform fine
+/// run ((1, 1), 40000 nodes) does, outside the 2δ discs around the crack tips: both within 1 °C
+/// (measured 0.38 and 0.37 °C, the PD discretisation at δ = 3Δ beside the crack faces; the bound is
+/// the one of `crack_plate_matches_finite_differences`), and within 0.2 °C of each other (measured
+/// 0.09 °C, at the region interface).
 #[test]
 fn dual_horizon_crack_plate_matches_finite_differences() {
     let plate = CrackPlate {

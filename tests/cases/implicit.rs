@@ -1,4 +1,4 @@
-//! Implicit schemes and the steady solve (formulation §4): temporal orders against an RK4
+//! Implicit schemes and the steady solve (theory §4): temporal orders against an RK4
 //! reference, steady state against the explicit run and exact/classical solutions, energy
 //! conservation, refusals, serial == parallel.
 
@@ -118,9 +118,9 @@ fn temporal_orders_against_rk4() {
     }
 }
 
-/// Nodal Dirichlet (driven nodes) and seed 000's flux relation (slaved nodes) are eliminated
-/// correctly: CN and BDF2 at h = 0.0025 s agree with RK4 to 1e-4 °C (their time error at this
-/// step is ~1e-6 °C on the mirrored bar above; a wrong elimination errs by O(1) °C).
+/// Nodal Dirichlet (driven nodes) and Bobaru & Duangpanya 2010's flux relation (slaved nodes) are
+/// eliminated correctly: CN and BDF2 at h = 0.0025 s agree with RK4 to 1e-4 °C (their time error at
+/// this step is ~1e-6 °C on the mirrored bar above; a wrong elimination errs by O(1) °C).
 #[test]
 fn nodal_and_relation_constraints_match_rk4() {
     let case = bar(

@@ -1,7 +1,8 @@
-//! Axisymmetric and spherical peridynamics (seed 001 §2.2–2.4, formulation §7): steady radial
-//! states against their exact solutions (second-order δ-convergence), the cooling sphere
-//! against its series, exact energy conservation of an insulated axisymmetric body, and the
-//! radial heat flux of seed 001 eq 25 against −k dθ/dr.
+//! Axisymmetric and spherical peridynamics (the axisymmetric phase-change paper,
+//! doi:10.1007/s42102-022-00092-3, §2.2–2.4; theory §7): steady radial states against their exact
+//! solutions (second-order δ-convergence), the cooling sphere against its series, exact energy
+//! conservation of an insulated axisymmetric body, and the radial heat flux of the paper's eq 25
+//! against −k dθ/dr.
 //!
 //! `cargo test --release --test cases symmetry:: -- --nocapture` prints the measured figures.
 
@@ -74,11 +75,11 @@ fn max_error(model: &Model, theta: &[f64], exact: &dyn Fn(f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Steady PD states of the wall at Δ = 1/40, 1/80, 1/160 of its thickness (m = 3) against
-/// the exact radial solutions: the largest nodal error falls as δ², observed rate ≥ 1.8
-/// between every pair (measured 1.98–2.00), and is below 0.05 °C of the 100 °C span at the
-/// finest spacing (measured 2.4e-3, 2.5e-3 and 6.5e-3 °C).
-/// - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a)) (seed 001 eq 10's Ω);
+/// Steady PD states of the wall at Δ = 1/40, 1/80, 1/160 of its thickness (m = 3) against the exact
+/// radial solutions: the largest nodal error falls as δ², observed rate ≥ 1.8 between every pair
+/// (measured 1.98–2.00), and is below 0.05 °C of the 100 °C span at the finest spacing (measured
+/// 2.4e-3, 2.5e-3 and 6.5e-3 °C). - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a)) (the
+/// axisymmetric phase-change paper, eq 10's Ω);
 /// - spherical shell: θ = A + B/r, B = 100 a b/(b − a), A = −B/b (eq 21's Ω_sp).
 ///
 /// A planar operator (Ω = 1) would give the straight line, up to 8.6 °C (at r = 0.72 m) away
@@ -115,11 +116,11 @@ fn steady_radial_states_converge_at_second_order() {
     }
 }
 
-/// The radial PD heat flux (formulation §8 with the true ring volume, i.e. seed 001 eq 25:
-/// q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric wall
-/// (1D, and 2D with its axial component) against Fourier's −k dθ/dr = 100 k/(r ln(b/a)),
-/// at Δ = (b − a)/80 and (b − a)/160:
-/// - nodes beyond the reach of the mirrored layers (δ + Δ/2 from both faces): for θ linear in ln r the first-order terms of Ω and of
+/// The radial PD heat flux (theory §8 with the true ring volume, i.e. the axisymmetric phase-change
+/// paper, eq 25: q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric
+/// wall (1D, and 2D with its axial component) against Fourier's −k dθ/dr = 100 k/(r ln(b/a)), at Δ
+/// = (b − a)/80 and (b − a)/160: - nodes beyond the reach of the mirrored layers (δ + Δ/2 from both
+/// faces): for θ linear in ln r the first-order terms of Ω and of
 ///   the curvature cancel in the half-horizon sum, so the relative difference is O(δ²):
 ///   below 1e-4 at the finer spacing (measured 2.9e-5; 1.1e-4 at the coarser) and falling
 ///   at least 3.5× when Δ halves (measured 4.0×);
@@ -170,13 +171,13 @@ fn radial_flux_matches_fourier() {
     }
 }
 
-/// Seed 001 §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k = 400, ρ = 8920,
-/// c = 385, θ0 = 1000 K, surface 300 K by mirrored layers, centre free) with Δ = R/20, R/40,
-/// R/80 (δ = 3Δ), forward Euler at 0.9 of the stable step, against the series
-/// `sphere_fixed_surface` at t = 2, 5 and 10 s: ε (seed 001 eq 27) falls as δ², observed
-/// rate ≥ 1.8 between every pair (measured 1.87–2.01), and is below 0.5 % (the paper's bar)
-/// on every grid (largest: 4.5e-3 at R/20, 10 s). The centre takes no layer (no bond
-/// crosses r = 0), as in the paper.
+/// The axisymmetric phase-change paper §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k =
+/// 400, ρ = 8920, c = 385, θ0 = 1000 K, surface 300 K by mirrored layers, centre free) with Δ =
+/// R/20, R/40, R/80 (δ = 3Δ), forward Euler at 0.9 of the stable step, against the series
+/// `sphere_fixed_surface` at t = 2, 5 and 10 s: ε (its eq 27) falls as δ², observed rate ≥ 1.8
+/// between every pair (measured 1.87–2.01), and is below 0.5 % (the paper's bar) on every grid
+/// (largest: 4.5e-3 at R/20, 10 s). The centre takes no layer (no bond crosses r = 0), as in the
+/// paper.
 #[test]
 fn sphere_cools_as_the_series() {
     let alpha = 400.0 / (8920.0 * 385.0);

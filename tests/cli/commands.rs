@@ -341,10 +341,10 @@ fn gmsh_cases_run_compare_and_refuse_bad_meshes() {
     assert!(!out2.exists(), "no output for a failed run");
 }
 
-/// `peritherm sweep` over the horizon of the seed 000 bar (δ halved twice at fixed Δ, to
-/// t = 0.1 s) writes one row per variant and output, and the max difference to the series
-/// falls as δ falls (the δ-convergence of seed 000 Fig. 10, measured 31.2 → 15.2 → 5.3 °C
-/// at t = 0.1 s, where the steep initial layer makes the error large). Against the first
+/// `peritherm sweep` over the horizon of the Bobaru & Duangpanya 2010 bar (δ halved twice at fixed
+/// Δ, to t = 0.1 s) writes one row per variant and output, and the max difference to the series
+/// falls as δ falls (the δ-convergence of Bobaru & Duangpanya 2010 Fig. 10, measured 31.2 → 15.2 →
+/// 5.3 °C at t = 0.1 s, where the steep initial layer makes the error large). Against the first
 /// variant instead, that variant's own row is zero.
 #[test]
 fn sweep_writes_a_table_and_converges_in_delta() {

@@ -1,5 +1,5 @@
-//! An independent classical reference for the seed 003 Example 3 crack plate: finite
-//! differences on a cell-centred grid, the crack as removed face conductances, solved by a
+//! An independent classical reference for the Bobaru & Duangpanya 2012 Example 3 crack plate:
+//! finite differences on a cell-centred grid, the crack as removed face conductances, solved by a
 //! sparse Cholesky factorisation (faer). It shares no code with peritherm's solvers.
 
 use faer::linalg::solvers::Solve;

@@ -1,5 +1,5 @@
 //! The built-in classical FEM solver (`peritherm fem`, src/fem/): second-order convergence in
-//! space against the analytical square and bar, the seed 003 crack plate against an
+//! space against the analytical square and bar, the Bobaru & Duangpanya 2012 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!
 //! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
@@ -123,11 +123,11 @@ edge = 0.0
 initial = 40.0
 "#;
 
-/// Seed 003 Example 1 (square, α = 1.14, θ0 = 40 °C, edges held at 0 °C) at t = 0.05 s on
-/// bilinear quads of h = 1/8, 1/16, 1/32: the largest nodal error falls as h², observed rate
-/// ≥ 1.8 between every pair. Crank–Nicolson with Δt = 1e-4 s (500 steps): its time error
-/// (O(Δt²), ~1e-6 °C) is far below the spatial one (~1e-2 °C at h = 1/32), so the rate
-/// measures space alone; 1.8 leaves room for the pre-asymptotic coarsest mesh.
+/// Bobaru & Duangpanya 2012 Example 1 (square, α = 1.14, θ0 = 40 °C, edges held at 0 °C) at t =
+/// 0.05 s on bilinear quads of h = 1/8, 1/16, 1/32: the largest nodal error falls as h², observed
+/// rate ≥ 1.8 between every pair. Crank–Nicolson with Δt = 1e-4 s (500 steps): its time error
+/// (O(Δt²), ~1e-6 °C) is far below the spatial one (~1e-2 °C at h = 1/32), so the rate measures
+/// space alone; 1.8 leaves room for the pre-asymptotic coarsest mesh.
 #[test]
 fn square_converges_at_second_order() {
     let c = case(SQUARE);
@@ -136,15 +136,15 @@ fn square_converges_at_second_order() {
         .map(|n| max_error(&c, 1.0 / n, 0.05, 500))
         .collect();
     let r = rates(&errors);
-    eprintln!("square (seed 003 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci(&errors));
+    eprintln!("square (Bobaru & Duangpanya 2012 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci(&errors));
     assert!(
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
     );
 }
 
-/// Seed 000 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0 °C) at
-/// t = 4 s on linear elements of h = L/10, L/20, L/40, L/80: rate ≥ 1.8 between every pair.
+/// Bobaru & Duangpanya 2010 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0
+/// °C) at t = 4 s on linear elements of h = L/10, L/20, L/40, L/80: rate ≥ 1.8 between every pair.
 /// Crank–Nicolson with Δt = 1e-3 s (time error ~1e-7 °C, far below the spatial ~1e-3 °C).
 #[test]
 fn bar_converges_at_second_order() {
@@ -167,7 +167,7 @@ fn bar_converges_at_second_order() {
         .collect();
     let r = rates(&errors);
     eprintln!(
-        "bar (seed 000 Ex. 1) t = 4 s, h = L/10 … L/80: max nodal error {} °C, rates {r:.3?}",
+        "bar (Bobaru & Duangpanya 2010 Ex. 1) t = 4 s, h = L/10 … L/80: max nodal error {} °C, rates {r:.3?}",
         sci(&errors)
     );
     assert!(
@@ -176,9 +176,9 @@ fn bar_converges_at_second_order() {
     );
 }
 
-/// The seed 003 Example 3 plate by the finite differences of tests/common/fd.rs (n × n cells
-/// on [−a, a]², crack |x| < c on y = 0, ±100 °C top and bottom): `steps` backward-Euler steps
-/// of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when `steps` = 0. Cells
+/// The Bobaru & Duangpanya 2012 Example 3 plate by the finite differences of tests/common/fd.rs (n
+/// × n cells on [−a, a]², crack |x| < c on y = 0, ±100 °C top and bottom): `steps` backward-Euler
+/// steps of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when `steps` = 0. Cells
 /// row by row.
 fn fd_plate(n: usize, a: f64, c: f64, alpha: f64, dt: f64, steps: usize) -> Vec<f64> {
     let plate = CrackPlate {
@@ -210,13 +210,13 @@ fn fem_at(model: &FemModel, theta: &[f64], nx: usize, a: f64, x: f64, y: f64) ->
     (0..4).map(|k| s.n[k] * theta[cell.nodes[k] as usize]).sum()
 }
 
-/// Seed 003 Example 3 (the bundled `cases/crack_plate.toml`: 2 × 2 cm, ±100 °C top and
-/// bottom, insulated sides and crack y = 0, |x| ≤ 0.5 cm, α = 1.14 cm²/s) by FEM on
-/// 200 × 200 bilinear quads (h = 0.1 mm; the crack's 99 interior nodes duplicated, the tips
-/// shared) against the finite differences of tests/common/fd.rs on 480 × 480 cells (h = 41.7 µm), compared at
-/// the FD cell centres of every other row and column (the FEM field interpolated in its quad,
-/// which never straddles the crack): the steady states, and the transient at 0.5 s from θ0 = 0
-/// with the same 200 backward-Euler steps in both (the time error is shared).
+/// Bobaru & Duangpanya 2012 Example 3 (the bundled `cases/crack_plate.toml`: 2 × 2 cm, ±100 °C top
+/// and bottom, insulated sides and crack y = 0, |x| ≤ 0.5 cm, α = 1.14 cm²/s) by FEM on 200 × 200
+/// bilinear quads (h = 0.1 mm; the crack's 99 interior nodes duplicated, the tips shared) against
+/// the finite differences of tests/common/fd.rs on 480 × 480 cells (h = 41.7 µm), compared at the
+/// FD cell centres of every other row and column (the FEM field interpolated in its quad, which
+/// never straddles the crack): the steady states, and the transient at 0.5 s from θ0 = 0 with the
+/// same 200 backward-Euler steps in both (the time error is shared).
 ///
 /// At the crack tips θ ~ r^½ and both discretisations converge slowly there (FEM on 240², 480²
 /// and 960² quads against FD on 960² cells, steady: 1.52, 1.02 and 0.67 °C next to a tip,
@@ -351,9 +351,9 @@ fn insulated_bodies_conserve_energy() {
     }
 }
 
-/// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header
-/// (the reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver "fem", the reference
-/// comparison) that `peritherm table` reads.
+/// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header (the
+/// reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver
+/// "fem", the reference comparison) that `peritherm table` reads.
 #[test]
 fn cli_writes_the_run_contract() {
     let dir = tempfile::tempdir().unwrap();
@@ -711,10 +711,10 @@ fn crank_nicolson_start_damps_the_initial_jump() {
     assert!(cn < be / 3.0, "CN {cn}, BE {be}");
 }
 
-/// A time-dependent held end: seed 004 §4.2 as a bar (L = 10 m, α = 1 m²/s, left end at
-/// 5 t e^(−2t) °C, right end insulated, θ0 = 0) at t = 3 s against the Duhamel series, on
-/// h = L/20, L/40, L/80: rate ≥ 1.8 between every pair (Crank–Nicolson, Δt = 1e-3 s: time
-/// error ~1e-7 °C, far below the spatial one).
+/// A time-dependent held end: Wang, Oterkus & Oterkus (dual-horizon paper) §4.2 as a bar (L = 10 m,
+/// α = 1 m²/s, left end at 5 t e^(−2t) °C, right end insulated, θ0 = 0) at t = 3 s against the
+/// Duhamel series, on h = L/20, L/40, L/80: rate ≥ 1.8 between every pair (Crank–Nicolson, Δt =
+/// 1e-3 s: time error ~1e-7 °C, far below the spatial one).
 #[test]
 fn time_dependent_held_end_converges_at_second_order() {
     let c = CaseToml::new(1)
@@ -735,7 +735,7 @@ fn time_dependent_held_end_converges_at_second_order() {
         .collect();
     let r = rates(&errors);
     eprintln!(
-        "bar with a held end at 5t·e^(−2t) (seed 004 §4.2 in 1D), t = 3 s, h = L/20, L/40, L/80: max nodal error {} °C, rates {r:.3?}",
+        "bar with a held end at 5t·e^(−2t) (Wang, Oterkus & Oterkus §4.2 in 1D), t = 3 s, h = L/20, L/40, L/80: max nodal error {} °C, rates {r:.3?}",
         sci(&errors)
     );
     assert!(
@@ -861,11 +861,12 @@ fn symmetric_steady_states_converge_at_second_order() {
     }
 }
 
-/// Seed 001 §3.2 (copper sphere R = 0.1 m, θ0 = 1000 K, surface held at 300 K, centre free)
-/// at t = 10 s on linear elements of h = R/40 … R/320 (3-point Gauss: 4πr² N_a N_b is of
-/// degree 4) against the series of `analytic::sphere_fixed_surface` (exact diffusivity
-/// k/(ρc)). Crank–Nicolson with Δt = 2.5e-3 s (4000 steps, Rannacher start); 4× more steps
-/// change no error by more than 2e-5 K, so the rates measure space alone.
+/// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.2 (copper sphere R = 0.1
+/// m, θ0 = 1000 K, surface held at 300 K, centre free) at t = 10 s on linear elements of h = R/40 …
+/// R/320 (3-point Gauss: 4πr² N_a N_b is of degree 4) against the series of
+/// `analytic::sphere_fixed_surface` (exact diffusivity k/(ρc)). Crank–Nicolson with Δt = 2.5e-3 s
+/// (4000 steps, Rannacher start); 4× more steps change no error by more than 2e-5 K, so the rates
+/// measure space alone.
 /// - nodes at r ≥ R/10: the largest error falls as h², rate ≥ 1.8 between every pair;
 /// - the centre node r = 0, where the shell weight 4πr² vanishes: its error converges more
 ///   slowly (measured rates 0.85 and 1.38 from R/10 to R/40, then 1.57, 1.67, 1.73, 1.77 up
@@ -908,7 +909,7 @@ fn sphere_converges_at_second_order() {
     }
     let (rb, rc) = (rates(&bulk), rates(&centre));
     eprintln!(
-        "sphere (seed 001 §3.2) t = 10 s, h = R/40 … R/320: max nodal error at r ≥ R/10 {} K, rates {rb:.3?}; at the centre {} K, rates {rc:.3?}",
+        "sphere (axisymmetric phase-change paper §3.2) t = 10 s, h = R/40 … R/320: max nodal error at r ≥ R/10 {} K, rates {rb:.3?}; at the centre {} K, rates {rc:.3?}",
         sci(&bulk),
         sci(&centre)
     );
@@ -922,12 +923,12 @@ fn sphere_converges_at_second_order() {
     );
 }
 
-/// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names.
-/// The pipe section of seed 001 §3.4 on quads of 0.04 m solved on the quads of 0.02 m: the
-/// other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long, the
-/// insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
-/// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's
-/// region, or `mesh` on a box case, is refused with one line naming the file and the key.
+/// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names. The pipe
+/// section of the axisymmetric phase-change paper §3.4 on quads of 0.04 m solved on the quads of
+/// 0.02 m: the other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long,
+/// the insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
+/// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's region, or
+/// `mesh` on a box case, is refused with one line naming the file and the key.
 #[test]
 fn reference_fem_mesh_solves_on_another_mesh() {
     let text = std::fs::read_to_string(root().join("cases/pipe_heating_2d.toml"))

@@ -7,8 +7,8 @@ use peritherm::report::classical_at;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// A 2D square held at 0 °C from 40 °C (seed 003 Example 1, coarse), its reference given by
-/// `reference` (TOML lines of the `[reference]` table).
+/// A 2D square held at 0 °C from 40 °C (Bobaru & Duangpanya 2012 Example 1, coarse), its reference
+/// given by `reference` (TOML lines of the `[reference]` table).
 fn square(reference: &str) -> String {
     let mut c = CaseToml::new(2)
         .domain("[0.0, 0.0]", "[1.0, 1.0]")

@@ -1,4 +1,4 @@
-//! Exact invariants of the boundary conditions of formulation §3: each rule reproduces the
+//! Exact invariants of the boundary conditions of theory §3: each rule reproduces the
 //! field it is built for, and the loads add exactly the energy they should.
 
 use crate::common::case::CaseToml;
@@ -81,9 +81,9 @@ value = "2 + t"
     }
 }
 
-/// Seed 003 §3.2 nodal flux relation on nodes on the boundary: with the lattice calibration
-/// the inward half-horizon sum gives exactly k ∂θ/∂n, so the relation keeps a linear field
-/// with gradient q/k unchanged (tolerance 1e-12 relative).
+/// Bobaru & Duangpanya 2012 §3.2 nodal flux relation on nodes on the boundary: with the lattice
+/// calibration the inward half-horizon sum gives exactly k ∂θ/∂n, so the relation keeps a linear
+/// field with gradient q/k unchanged (tolerance 1e-12 relative).
 #[test]
 fn nodal_flux_relation_keeps_the_matching_linear_field() {
     let faces = r#"
@@ -114,7 +114,8 @@ value = 6.0
     assert!(n > 5);
 }
 
-/// Seed 000 eq 22 in 1D: the nodes within δ of the end follow the anchor with gradient q/k.
+/// Bobaru & Duangpanya 2010 eq 22 in 1D: the nodes within δ of the end follow the anchor with
+/// gradient q/k.
 #[test]
 fn bar_flux_relation_sets_the_gradient() {
     let m = CaseToml::new(1)

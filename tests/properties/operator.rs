@@ -433,7 +433,7 @@ fn neighbour_search_grid_equals_tree() {
     assert_eq!(a.targets, model.horizons.targets);
 }
 
-/// The Gershgorin bound of formulation §4 is safe and not far from the truth: Euler at the
+/// The Gershgorin bound of theory §4 is safe and not far from the truth: Euler at the
 /// bound stays bounded; Euler at 1.2× the true limit 2/λ_max (power iteration) blows up;
 /// a user Δt above the bound is refused with the bound in the message.
 #[test]
