@@ -1181,7 +1181,7 @@ mod tests {
     /// heat ∫ρcθ dx equals the absorbed energy s0·l(1 − e^(−L/l))·∫g dt (Simpson over 400
     /// points of the series against the closed form, 1e-9 relative: the mode n = 0 carries
     /// all of it, so this checks e_0 and the time integral; the higher modes are checked
-    /// against finite differences in tests/series.rs).
+    /// against finite differences in tests/convergence/series.rs).
     #[test]
     fn laser_series_meets_its_data() {
         let (l, t0, a, depth) = (2e-8, 100e-15, 1.992, 15.3e-9);

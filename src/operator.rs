@@ -80,7 +80,7 @@ fn unit_normalisations(cloud: &Cloud, kernel: &Kernel) -> Vec<f64> {
 /// Rows per parallel task of the bond sums (the order inside a row never depends on it).
 pub const ROW_CHUNK: usize = 2048;
 
-/// Σ_k v_k (θ[c_k] − θ_i) over one row of K, W: four partial sums over the entries 4q + r,
+/// Σ_k v_k (θ\[c_k\] − θ_i) over one row of K, W: four partial sums over the entries 4q + r,
 /// added as (s0 + s1) + (s2 + s3) after the remainder joined s0. The order is fixed by the row
 /// alone, so every thread count gives the same bits (theory §2, gather form).
 #[inline(always)]

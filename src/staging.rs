@@ -26,7 +26,7 @@ static REACHED: AtomicU64 = AtomicU64::new(0);
 /// Distinguishes the staged directories of one process.
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
 
-/// The lock of [`WRITING`], poisoned or not.
+/// The lock of `WRITING`, poisoned or not.
 pub fn writing() -> MutexGuard<'static, ()> {
     WRITING.lock().unwrap_or_else(|e| e.into_inner())
 }

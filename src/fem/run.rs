@@ -1,5 +1,5 @@
-//! Running a case with the FEM solver: the same outputs as `peritherm run` (field_<k>.csv,
-//! field_<k>.vtu, run.json with the reference comparison), written atomically.
+//! Running a case with the FEM solver: the same outputs as `peritherm run` (`field_<k>.csv`,
+//! `field_<k>.vtu`, run.json with the reference comparison), written atomically.
 
 use super::assemble::{assemble, System};
 use super::boundary::Conditions;

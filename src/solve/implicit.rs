@@ -24,7 +24,7 @@
 //! coefficient c (so once per Δt); nonsymmetric A: sparse LU with partial pivoting (faer,
 //! COLAMD) of the same matrix. Jacobi-preconditioned conjugate gradients ([`Solver::Cg`],
 //! symmetric A only) are kept for comparison. Measured per solve (`cargo test --release --test
-//! implicit -- --ignored --nocapture`, Crank–Nicolson; 2 cores shared with other jobs, load
+//! cases implicit:: -- --ignored --nocapture`, Crank–Nicolson; 2 cores shared with other jobs, load
 //! average 5–7, so ±30 %): crack plate (40 000 unknowns, Δt = 0.01 s) 71 ms direct against
 //! 505 ms CG (83 iterations to 1e-11), factorisation 0.98 s; thermal shock (250 000 unknowns,
 //! Δt = 0.05 s) 0.43 s direct against 6.0 s CG (100 iterations), factorisation 6.9 s with

@@ -27,7 +27,7 @@
 //!
 //! Two short cuts: a cloud already consistent to [`TOLERANCE`] (a lattice without a horizon
 //! change) keeps K bit for bit, and the linear order first tries the additive form of one
-//! linear solve ([`additive`]), exact in one step, falling back to the entropy form only where
+//! linear solve (`additive`), exact in one step, falling back to the entropy form only where
 //! that would make a pair non-positive. The Newton iterations, the parallel sums and hence the
 //! weights are the same bits at any thread count.
 //!

@@ -1,5 +1,5 @@
-//! An independent classical reference for the seed 003 Example 3 crack plate: finite
-//! differences on a cell-centred grid, the crack as removed face conductances, solved by a
+//! An independent classical reference for the Bobaru & Duangpanya 2012 Example 3 crack plate:
+//! finite differences on a cell-centred grid, the crack as removed face conductances, solved by a
 //! sparse Cholesky factorisation (faer). It shares no code with peritherm's solvers.
 
 use faer::linalg::solvers::Solve;
@@ -31,6 +31,7 @@ impl CrackPlate {
     }
 
     /// Temperature of the cell containing (x, y), °C, from a field returned by a solve.
+    #[allow(dead_code)] // used by the `cases` target (cracks.rs), not by `convergence` (fem.rs)
     pub fn at(&self, field: &[f64], x: f64, y: f64) -> f64 {
         let cell = |v: f64| (((v + self.a) / self.h()).floor() as usize).min(self.n - 1);
         field[cell(y) * self.n + cell(x)]
@@ -39,6 +40,7 @@ impl CrackPlate {
     /// Temperature at (x, y), °C, bilinear between the four nearest cell centres of a field
     /// returned by a solve; never across the crack (beside it, only the row on the point's
     /// side is used).
+    #[allow(dead_code)] // used by the `cases` target (cracks.rs), not by `convergence` (fem.rs)
     pub fn interpolate(&self, field: &[f64], x: f64, y: f64) -> f64 {
         let n = self.n;
         let split = |v: f64| {

@@ -1,4 +1,4 @@
-//! Helpers of the hostile-input tests (`tests/hostile.rs`, `tests/fuzz.rs`): a small case,
+//! Helpers of the hostile-input tests (`tests/cli/hostile.rs`, `tests/cli/fuzz.rs`): a small case,
 //! the CLI under a memory limit and a clock, and a seeded mutation generator.
 
 use std::path::{Path, PathBuf};
@@ -64,11 +64,7 @@ pub fn peritherm(args: &[&str]) -> Outcome {
     } else {
         cmd.arg(format!("ulimit -v {ADDRESS_KIB}; exec \"$0\" \"$@\""));
     }
-    let o = cmd
-        .arg(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap();
+    let o = cmd.arg(super::cli::EXE).args(args).output().unwrap();
     let max_kib = std::fs::read_to_string(report.path())
         .ok()
         .and_then(|s| s.lines().last().and_then(|l| l.trim().parse().ok()))

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Regenerates the gmsh fixtures of tests/gmsh.rs (needs `pip install gmsh`; tested with 4.15).
+"""Regenerates the gmsh fixtures of tests/properties/gmsh.rs (needs `pip install gmsh`; tested with 4.15).
 
 Run from anywhere: `python3 tests/data/make_fixtures.py`. The .msh files are committed, so the
 tests never need gmsh.

@@ -11,9 +11,7 @@
 //! t = 0 makes it largest there) measured 2.5e-5 θ0 (rectangle), 1.9e-4 θ0 (box) and
 //! 3.5e-6 θ0 (disc) when this test was written, so a 5× margin on the worst.
 
-mod common;
-
-use common::heat_fd::{disc_fd, plate_held_left_fd, slab_source_fd, BoxFd};
+use crate::common::heat_fd::{disc_fd, plate_held_left_fd, slab_source_fd, BoxFd};
 use peritherm::analytic::{AxisEnds, Reference};
 use peritherm::math::Point;
 

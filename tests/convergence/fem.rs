@@ -1,27 +1,42 @@
 //! The built-in classical FEM solver (`peritherm fem`, src/fem/): second-order convergence in
-//! space against the analytical square and bar, the seed 003 crack plate against an
+//! space against the analytical square and bar, the Bobaru & Duangpanya 2012 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!
-//! `cargo test --release --test fem -- --nocapture` prints the measured figures quoted in the
-//! README.
+//! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
+//! quoted in the README.
 
-mod common;
-
-use common::fd::CrackPlate;
+use crate::common::case::CaseToml;
+use crate::common::cli::{peritherm, write_case};
+use crate::common::fd::CrackPlate;
 use peritherm::case::Case;
 use peritherm::fem::run::FemModel;
 use peritherm::fem::shape::shape;
 use peritherm::fem::solve::{Scheme, Stepper};
 use peritherm::mesh::ElementKind;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Where the test cases pretend to live (relative paths in them resolve from `cases/`).
+fn in_cases() -> PathBuf {
+    root().join("cases/test.toml")
+}
+
 fn case(text: &str) -> Case {
-    Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+    Case::parse(text, &in_cases()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The refined crack plate mesh (2 × 2 cm, τ = 0.1 mm, δ = 3Δ), k = 114, ρc = 1e6, with no
+/// crack, initial field or time yet.
+fn refined_plate() -> CaseToml {
+    CaseToml::new(2)
+        .mesh("../meshes/crack_plate_refined.msh")
+        .mesh_key("thickness = 1e-4")
+        .region("zone", "", 3.0)
+        .region("far", "", 3.0)
+        .material("plate", 114.0, 1e6, 1.0)
 }
 
 /// The case's analytical reference series.
@@ -108,11 +123,11 @@ edge = 0.0
 initial = 40.0
 "#;
 
-/// Seed 003 Example 1 (square, α = 1.14, θ0 = 40 °C, edges held at 0 °C) at t = 0.05 s on
-/// bilinear quads of h = 1/8, 1/16, 1/32: the largest nodal error falls as h², observed rate
-/// ≥ 1.8 between every pair. Crank–Nicolson with Δt = 1e-4 s (500 steps): its time error
-/// (O(Δt²), ~1e-6 °C) is far below the spatial one (~1e-2 °C at h = 1/32), so the rate
-/// measures space alone; 1.8 leaves room for the pre-asymptotic coarsest mesh.
+/// Bobaru & Duangpanya 2012 Example 1 (square, α = 1.14, θ0 = 40 °C, edges held at 0 °C) at t =
+/// 0.05 s on bilinear quads of h = 1/8, 1/16, 1/32: the largest nodal error falls as h², observed
+/// rate ≥ 1.8 between every pair. Crank–Nicolson with Δt = 1e-4 s (500 steps): its time error
+/// (O(Δt²), ~1e-6 °C) is far below the spatial one (~1e-2 °C at h = 1/32), so the rate measures
+/// space alone; 1.8 leaves room for the pre-asymptotic coarsest mesh.
 #[test]
 fn square_converges_at_second_order() {
     let c = case(SQUARE);
@@ -121,59 +136,38 @@ fn square_converges_at_second_order() {
         .map(|n| max_error(&c, 1.0 / n, 0.05, 500))
         .collect();
     let r = rates(&errors);
-    eprintln!("square (seed 003 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci(&errors));
+    eprintln!("square (Bobaru & Duangpanya 2012 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci(&errors));
     assert!(
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
     );
 }
 
-const BAR: &str = r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [10.0]
-[[region]]
-name = "bar"
-spacing = 0.5
-horizon = { factor = 3 }
-[material.paper]
-conductivity = 1.14
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = 0.0
-[boundary.x_max]
-type = "temperature"
-value = 0.0
-[initial]
-value = 100.0
-[time]
-end = 4.0
-[reference.solution]
-kind = "bar_fixed_ends"
-x0 = 0.0
-length = 10.0
-diffusivity = 1.14
-left = 0.0
-right = 0.0
-initial = 100.0
-"#;
-
-/// Seed 000 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0 °C) at
-/// t = 4 s on linear elements of h = L/10, L/20, L/40, L/80: rate ≥ 1.8 between every pair.
+/// Bobaru & Duangpanya 2010 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0
+/// °C) at t = 4 s on linear elements of h = L/10, L/20, L/40, L/80: rate ≥ 1.8 between every pair.
 /// Crank–Nicolson with Δt = 1e-3 s (time error ~1e-7 °C, far below the spatial ~1e-3 °C).
 #[test]
 fn bar_converges_at_second_order() {
-    let c = case(BAR);
+    let c = CaseToml::new(1)
+        .domain("[0.0]", "[10.0]")
+        .region("bar", "spacing = 0.5", 3.0)
+        .material("paper", 1.14, 1.0, 1.0)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nvalue = 0.0\n\
+             [boundary.x_max]\ntype = \"temperature\"\nvalue = 0.0\n\
+             [reference.solution]\nkind = \"bar_fixed_ends\"\nx0 = 0.0\nlength = 10.0\n\
+             diffusivity = 1.14\nleft = 0.0\nright = 0.0\ninitial = 100.0",
+        )
+        .initial_value(100.0)
+        .end(4.0)
+        .case(in_cases());
     let errors: Vec<f64> = [10.0, 20.0, 40.0, 80.0]
         .iter()
         .map(|n| max_error(&c, 10.0 / n, 4.0, 4000))
         .collect();
     let r = rates(&errors);
     eprintln!(
-        "bar (seed 000 Ex. 1) t = 4 s, h = L/10 … L/80: max nodal error {} °C, rates {r:.3?}",
+        "bar (Bobaru & Duangpanya 2010 Ex. 1) t = 4 s, h = L/10 … L/80: max nodal error {} °C, rates {r:.3?}",
         sci(&errors)
     );
     assert!(
@@ -182,9 +176,9 @@ fn bar_converges_at_second_order() {
     );
 }
 
-/// The seed 003 Example 3 plate by the finite differences of tests/common/fd.rs (n × n cells
-/// on [−a, a]², crack |x| < c on y = 0, ±100 °C top and bottom): `steps` backward-Euler steps
-/// of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when `steps` = 0. Cells
+/// The Bobaru & Duangpanya 2012 Example 3 plate by the finite differences of tests/common/fd.rs (n
+/// × n cells on [−a, a]², crack |x| < c on y = 0, ±100 °C top and bottom): `steps` backward-Euler
+/// steps of `dt` from θ0 = 0 with diffusivity `alpha`, or the steady state when `steps` = 0. Cells
 /// row by row.
 fn fd_plate(n: usize, a: f64, c: f64, alpha: f64, dt: f64, steps: usize) -> Vec<f64> {
     let plate = CrackPlate {
@@ -216,19 +210,19 @@ fn fem_at(model: &FemModel, theta: &[f64], nx: usize, a: f64, x: f64, y: f64) ->
     (0..4).map(|k| s.n[k] * theta[cell.nodes[k] as usize]).sum()
 }
 
-/// Seed 003 Example 3 (the bundled `cases/crack_plate.toml`: 2 × 2 cm, ±100 °C top and
-/// bottom, insulated sides and crack y = 0, |x| ≤ 0.5 cm, α = 1.14 cm²/s) by FEM on
-/// 200 × 200 bilinear quads (h = 0.1 mm; the crack's 99 interior nodes duplicated, the tips
-/// shared) against the finite differences of tests/common/fd.rs on 480 × 480 cells (h = 41.7 µm), compared at
-/// the FD cell centres of every other row and column (the FEM field interpolated in its quad,
-/// which never straddles the crack): the steady states, and the transient at 0.5 s from θ0 = 0
-/// with the same 200 backward-Euler steps in both (the time error is shared).
+/// Bobaru & Duangpanya 2012 Example 3 (the bundled `cases/crack_plate.toml`: 2 × 2 cm, ±100 °C top
+/// and bottom, insulated sides and crack y = 0, |x| ≤ 0.5 cm, α = 1.14 cm²/s) by FEM on 200 × 200
+/// bilinear quads (h = 0.1 mm; the crack's 99 interior nodes duplicated, the tips shared) against
+/// the finite differences of tests/common/fd.rs on 480 × 480 cells (h = 41.7 µm), compared at the
+/// FD cell centres of every other row and column (the FEM field interpolated in its quad, which
+/// never straddles the crack): the steady states, and the transient at 0.5 s from θ0 = 0 with the
+/// same 200 backward-Euler steps in both (the time error is shared).
 ///
 /// At the crack tips θ ~ r^½ and both discretisations converge slowly there (FEM on 240², 480²
 /// and 960² quads against FD on 960² cells, steady: 1.52, 1.02 and 0.67 °C next to a tip,
 /// 0.35, 0.23 and 0.17 °C beyond 1 mm of them; see `crack_plate_resolution_study`), so the
 /// bound of 0.5 °C is asserted outside the discs of radius 2δ = 2.17 mm around the tips, as
-/// the PD test in tests/cracks.rs does, and the differences everywhere and beyond 1 mm are
+/// the PD test in tests/cases/cracks.rs does, and the differences everywhere and beyond 1 mm are
 /// printed.
 #[test]
 fn crack_plate_matches_finite_differences() {
@@ -291,145 +285,48 @@ fn crack_plate_matches_finite_differences() {
 /// capacities are ring and shell volumes.
 #[test]
 fn insulated_bodies_conserve_energy() {
-    let texts = [
-        r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "100*sin(7*x)*cos(3*y) + 20"
-[time]
-end = 0.5
-"#
-        .to_string(),
-        r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "100*sin(7*x) + 20"
-[time]
-end = 0.5
-"#
-        .to_string(),
-        r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "a"
-max = [0.3]
-spacing = 0.05
-horizon = { factor = 3 }
-material = "x"
-[[region]]
-name = "b"
-min = [0.3]
-spacing = 0.1
-horizon = { factor = 3 }
-material = "y"
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[material.y]
-conductivity = 0.5
-density = 1.0
-specific_heat = 1.0
-[initial]
-value = "100*sin(7*x) + 20"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-thickness = 0.1
-[[region]]
-name = "a"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[[crack]]
-points = [[0.2, 0.25], [0.7, 0.25], [0.7, 0.4]]
-[initial]
-value = "y > 0.25"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 3
-[domain]
-min = [0.0, 0.0, 0.0]
-max = [1.0, 0.5, 0.5]
-[[region]]
-name = "a"
-spacing = 0.1
-horizon = { factor = 3 }
-[material.x]
-conductivity = 2.0
-density = 3.0
-specific_heat = 5.0
-[initial]
-value = "x*y + 10*z"
-[time]
-end = 1.0
-"#
-        .to_string(),
-        r#"
-dimension = 2
-[mesh]
-file = "../meshes/crack_plate_refined.msh"
-thickness = 1e-4
-[[region]]
-name = "zone"
-horizon = { factor = 3 }
-[[region]]
-name = "far"
-horizon = { factor = 3 }
-[material.plate]
-conductivity = 114.0
-density = 1e6
-specific_heat = 1.0
-[[crack]]
-group = "crack"
-[initial]
-value = "100*(y > 0)"
-[time]
-end = 0.1
-"#
-        .to_string(),
+    // k = 2, ρ = 3, c = 5
+    let x = |c: CaseToml| c.material("x", 2.0, 3.0, 5.0);
+    let cases = [
+        x(CaseToml::new(2)
+            .key("symmetry = \"axisymmetric\"")
+            .domain("[0.0, 0.0]", "[1.0, 0.5]")
+            .region("a", "spacing = 0.05", 3.0))
+        .initial("100*sin(7*x)*cos(3*y) + 20")
+        .end(0.5),
+        x(CaseToml::new(1)
+            .key("symmetry = \"spherical\"")
+            .domain("[0.0]", "[1.0]")
+            .region("a", "spacing = 0.05", 3.0))
+        .initial("100*sin(7*x) + 20")
+        .end(0.5),
+        x(CaseToml::new(1)
+            .domain("[0.0]", "[1.0]")
+            .region("a", "spacing = 0.05", 3.0)
+            .region_key("max = [0.3]")
+            .region_key("material = \"x\"")
+            .region("b", "spacing = 0.1", 3.0)
+            .region_key("min = [0.3]")
+            .region_key("material = \"y\""))
+        .material("y", 0.5, 1.0, 1.0)
+        .initial("100*sin(7*x) + 20"),
+        x(CaseToml::new(2)
+            .domain("[0.0, 0.0]", "[1.0, 0.5]")
+            .domain_key("thickness = 0.1")
+            .region("a", "spacing = 0.05", 3.0))
+        .section("[[crack]]\npoints = [[0.2, 0.25], [0.7, 0.25], [0.7, 0.4]]")
+        .initial("y > 0.25"),
+        x(CaseToml::new(3)
+            .domain("[0.0, 0.0, 0.0]", "[1.0, 0.5, 0.5]")
+            .region("a", "spacing = 0.1", 3.0))
+        .initial("x*y + 10*z"),
+        refined_plate()
+            .section("[[crack]]\ngroup = \"crack\"")
+            .initial("100*(y > 0)")
+            .end(0.1),
     ];
-    for text in &texts {
-        let c = case(text);
+    for case in &cases {
+        let c = case.case(in_cases());
         let model = FemModel::build(&c, None).unwrap();
         let e0 = model.energy(&model.theta0);
         let theta = integrate(&model, Scheme::BackwardEuler, c.end, 20);
@@ -454,27 +351,15 @@ end = 0.1
     }
 }
 
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn write_case(dir: &Path, text: &str) -> String {
-    let p = dir.join("case.toml");
-    std::fs::write(&p, text).unwrap();
-    p.display().to_string()
-}
-
-/// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header
-/// (the reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver "fem", the reference
-/// comparison) that `peritherm table` reads.
+/// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header (the
+/// reference column included) and one row per FEM node, field_<k>.vtu, and a run.json (solver
+/// "fem", the reference comparison) that `peritherm table` reads.
 #[test]
 fn cli_writes_the_run_contract() {
     let dir = tempfile::tempdir().unwrap();
     let case = write_case(
         dir.path(),
+        "case.toml",
         &SQUARE.replace("end = 0.05", "end = 0.05\noutputs = [0.01, 0.05]"),
     );
     let out = dir.path().join("out");
@@ -556,7 +441,7 @@ fn unsupported_cases_give_clear_errors() {
         ),
     ];
     for (text, extra, key, what) in cases {
-        let path = write_case(dir.path(), &text);
+        let path = write_case(dir.path(), "case.toml", &text);
         let out = dir.path().join("out");
         let mut args = vec!["fem", &path, "--out", out.to_str().unwrap()];
         args.extend(extra);
@@ -624,16 +509,16 @@ fn steady_linear_fields_and_loads_are_exact() {
             2 => ("[0.0, 0.0]", "[2.0, 1.0]"),
             _ => ("[0.0, 0.0, 0.0]", "[2.0, 1.0, 0.5]"),
         };
-        let extent = if dim == 2 {
-            "thickness = 0.3"
+        let mut c = CaseToml::new(dim).domain(min, max);
+        if dim == 2 {
+            c = c.domain_key("thickness = 0.3");
         } else if dim == 1 {
-            "area = 0.3"
-        } else {
-            ""
-        };
-        format!(
-            "dimension = {dim}\n[domain]\nmin = {min}\nmax = {max}\n{extent}\n[[region]]\nname = \"r\"\nspacing = 0.25\nhorizon = {{ factor = 3 }}\n[material.m]\nconductivity = 4.0\ndensity = 1.0\nspecific_heat = 1.0\n{faces}\n[time]\nend = 1.0\n"
-        )
+            c = c.domain_key("area = 0.3");
+        }
+        c.region("r", "spacing = 0.25", 3.0)
+            .material("m", 4.0, 1.0, 1.0)
+            .section(faces)
+            .text()
     };
     let check = |what: &str, model: &FemModel, theta: &[f64], exact: &dyn Fn(f64) -> f64| {
         let worst = model
@@ -666,11 +551,11 @@ fn steady_linear_fields_and_loads_are_exact() {
     check("source", &m, &t, &|x| 50.0 * x * (2.0 - x) / 8.0);
 }
 
-/// Resolution study of the steady crack plate behind the README's figures (ignored: ~15 s;
-/// run with `cargo test --release --test fem -- --ignored --nocapture`): FEM on n² quads and
-/// FD on n² cells for n = 240, 480, 960, each compared with FD on 960² cells at the centres
-/// of the 240² cells (finer FD fields interpolated there from the 4 cells around the point),
-/// next to the tips and beyond 1 mm of them.
+/// Resolution study of the steady crack plate behind the README's figures (ignored: ~15 s; run
+/// with `cargo test --release --test convergence fem:: -- --ignored --nocapture`): FEM on n²
+/// quads and FD on n² cells for n = 240, 480, 960, each compared with FD on 960² cells at the
+/// centres of the 240² cells (finer FD fields interpolated there from the 4 cells around the
+/// point), next to the tips and beyond 1 mm of them.
 #[test]
 #[ignore]
 fn crack_plate_resolution_study() {
@@ -737,27 +622,13 @@ fn crack_plate_resolution_study() {
 /// the nodes its physical group does.
 #[test]
 fn cracks_split_what_they_should() {
-    let text = r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]
-[initial]
-value = "(y > 0.6) * 100"
-[time]
-end = 1.0
-"#;
-    let c = case(text);
+    let c = CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 1.0]")
+        .region("r", "spacing = 0.05", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .section("[[crack]]\npoints = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]")
+        .initial("(y > 0.6) * 100")
+        .case(in_cases());
     let model = FemModel::build(&c, None).unwrap();
     let theta = integrate(&model, Scheme::BackwardEuler, 1.0, 50);
     let upper = |p: &peritherm::math::Point, cell_centre_y: f64| {
@@ -805,29 +676,11 @@ end = 1.0
     assert!(moved > 1.0, "heat moves inside the upper half");
 
     let gmsh = |crack: &str| {
-        let text = format!(
-            r#"
-dimension = 2
-[mesh]
-file = "../meshes/crack_plate_refined.msh"
-thickness = 1e-4
-[[region]]
-name = "zone"
-horizon = {{ factor = 3 }}
-[[region]]
-name = "far"
-horizon = {{ factor = 3 }}
-[material.plate]
-conductivity = 114.0
-density = 1e6
-specific_heat = 1.0
-[[crack]]
-{crack}
-[time]
-end = 0.1
-"#
-        );
-        FemModel::build(&case(&text), None).unwrap().split_nodes
+        let c = refined_plate()
+            .section(&format!("[[crack]]\n{crack}"))
+            .end(0.1)
+            .case(in_cases());
+        FemModel::build(&c, None).unwrap().split_nodes
     };
     let by_group = gmsh("group = \"crack\"");
     let by_points = gmsh("points = [[-0.005, 0.0], [0.005, 0.0]]");
@@ -858,48 +711,31 @@ fn crank_nicolson_start_damps_the_initial_jump() {
     assert!(cn < be / 3.0, "CN {cn}, BE {be}");
 }
 
-/// A time-dependent held end: seed 004 §4.2 as a bar (L = 10 m, α = 1 m²/s, left end at
-/// 5 t e^(−2t) °C, right end insulated, θ0 = 0) at t = 3 s against the Duhamel series, on
-/// h = L/20, L/40, L/80: rate ≥ 1.8 between every pair (Crank–Nicolson, Δt = 1e-3 s: time
-/// error ~1e-7 °C, far below the spatial one).
+/// A time-dependent held end: Wang, Oterkus & Oterkus (dual-horizon paper) §4.2 as a bar (L = 10 m,
+/// α = 1 m²/s, left end at 5 t e^(−2t) °C, right end insulated, θ0 = 0) at t = 3 s against the
+/// Duhamel series, on h = L/20, L/40, L/80: rate ≥ 1.8 between every pair (Crank–Nicolson, Δt =
+/// 1e-3 s: time error ~1e-7 °C, far below the spatial one).
 #[test]
 fn time_dependent_held_end_converges_at_second_order() {
-    let text = r#"
-dimension = 1
-[domain]
-min = [-5.0]
-max = [5.0]
-[[region]]
-name = "bar"
-spacing = 0.5
-horizon = { factor = 3 }
-[material.unit]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = "5*t*exp(-2*t)"
-[boundary.x_max]
-type = "insulated"
-[time]
-end = 3.0
-[reference.solution]
-kind = "bar_pulse_left"
-x0 = -5.0
-length = 10.0
-diffusivity = 1.0
-amplitude = 5.0
-rate = 2.0
-"#;
-    let c = case(text);
+    let c = CaseToml::new(1)
+        .domain("[-5.0]", "[5.0]")
+        .region("bar", "spacing = 0.5", 3.0)
+        .material("unit", 1.0, 1.0, 1.0)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nvalue = \"5*t*exp(-2*t)\"\n\
+             [boundary.x_max]\ntype = \"insulated\"\n\
+             [reference.solution]\nkind = \"bar_pulse_left\"\nx0 = -5.0\nlength = 10.0\n\
+             diffusivity = 1.0\namplitude = 5.0\nrate = 2.0",
+        )
+        .end(3.0)
+        .case(in_cases());
     let errors: Vec<f64> = [20.0, 40.0, 80.0]
         .iter()
         .map(|n| max_error(&c, 10.0 / n, 3.0, 3000))
         .collect();
     let r = rates(&errors);
     eprintln!(
-        "bar with a held end at 5t·e^(−2t) (seed 004 §4.2 in 1D), t = 3 s, h = L/20, L/40, L/80: max nodal error {} °C, rates {r:.3?}",
+        "bar with a held end at 5t·e^(−2t) (Wang, Oterkus & Oterkus §4.2 in 1D), t = 3 s, h = L/20, L/40, L/80: max nodal error {} °C, rates {r:.3?}",
         sci(&errors)
     );
     assert!(
@@ -941,9 +777,14 @@ fn radial(symmetry: &str, dim: usize, faces: &str) -> String {
     } else {
         ("[0.5, 0.0]", "[1.0, 0.25]")
     };
-    format!(
-        "dimension = {dim}\nsymmetry = \"{symmetry}\"\n[domain]\nmin = {min}\nmax = {max}\n[[region]]\nname = \"r\"\nspacing = 0.05\nhorizon = {{ factor = 3 }}\n[material.m]\nconductivity = 4.0\ndensity = 1.0\nspecific_heat = 1.0\n{faces}\n[initial]\nvalue = 0.0\n[time]\nend = 1.0\n"
-    )
+    CaseToml::new(dim)
+        .key(&format!("symmetry = \"{symmetry}\""))
+        .domain(min, max)
+        .region("r", "spacing = 0.05", 3.0)
+        .material("m", 4.0, 1.0, 1.0)
+        .section(faces)
+        .initial_value(0.0)
+        .text()
 }
 
 /// Steady radial conduction with exact solutions, on elements of h = 1/20 … 1/160 of the
@@ -1020,40 +861,12 @@ fn symmetric_steady_states_converge_at_second_order() {
     }
 }
 
-const SPHERE: &str = r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [0.1]
-[[region]]
-name = "ball"
-spacing = 0.01
-horizon = { factor = 3 }
-[material.copper]
-conductivity = 400.0
-density = 8920.0
-specific_heat = 385.0
-[boundary.x_max]
-type = "temperature"
-value = 300.0
-[initial]
-value = 1000.0
-[time]
-end = 10.0
-[reference.solution]
-kind = "sphere_fixed_surface"
-radius = 0.1
-diffusivity = 1.1647e-4
-surface = 300.0
-initial = 1000.0
-"#;
-
-/// Seed 001 §3.2 (copper sphere R = 0.1 m, θ0 = 1000 K, surface held at 300 K, centre free)
-/// at t = 10 s on linear elements of h = R/40 … R/320 (3-point Gauss: 4πr² N_a N_b is of
-/// degree 4) against the series of `analytic::sphere_fixed_surface` (exact diffusivity
-/// k/(ρc)). Crank–Nicolson with Δt = 2.5e-3 s (4000 steps, Rannacher start); 4× more steps
-/// change no error by more than 2e-5 K, so the rates measure space alone.
+/// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.2 (copper sphere R = 0.1
+/// m, θ0 = 1000 K, surface held at 300 K, centre free) at t = 10 s on linear elements of h = R/40 …
+/// R/320 (3-point Gauss: 4πr² N_a N_b is of degree 4) against the series of
+/// `analytic::sphere_fixed_surface` (exact diffusivity k/(ρc)). Crank–Nicolson with Δt = 2.5e-3 s
+/// (4000 steps, Rannacher start); 4× more steps change no error by more than 2e-5 K, so the rates
+/// measure space alone.
 /// - nodes at r ≥ R/10: the largest error falls as h², rate ≥ 1.8 between every pair;
 /// - the centre node r = 0, where the shell weight 4πr² vanishes: its error converges more
 ///   slowly (measured rates 0.85 and 1.38 from R/10 to R/40, then 1.57, 1.67, 1.73, 1.77 up
@@ -1063,7 +876,19 @@ initial = 1000.0
 fn sphere_converges_at_second_order() {
     const STEPS: usize = 4000;
     let alpha = 400.0 / (8920.0 * 385.0);
-    let c = case(&SPHERE.replace("1.1647e-4", &format!("{alpha:e}")));
+    let c = CaseToml::new(1)
+        .key("symmetry = \"spherical\"")
+        .domain("[0.0]", "[0.1]")
+        .region("ball", "spacing = 0.01", 3.0)
+        .material("copper", 400.0, 8920.0, 385.0)
+        .section(&format!(
+            "[boundary.x_max]\ntype = \"temperature\"\nvalue = 300.0\n\
+             [reference.solution]\nkind = \"sphere_fixed_surface\"\nradius = 0.1\n\
+             diffusivity = {alpha:e}\nsurface = 300.0\ninitial = 1000.0"
+        ))
+        .initial_value(1000.0)
+        .end(10.0)
+        .case(in_cases());
     let r = analytic(&c);
     let (mut bulk, mut centre) = (Vec::new(), Vec::new());
     for n in [40.0, 80.0, 160.0, 320.0] {
@@ -1084,7 +909,7 @@ fn sphere_converges_at_second_order() {
     }
     let (rb, rc) = (rates(&bulk), rates(&centre));
     eprintln!(
-        "sphere (seed 001 §3.2) t = 10 s, h = R/40 … R/320: max nodal error at r ≥ R/10 {} K, rates {rb:.3?}; at the centre {} K, rates {rc:.3?}",
+        "sphere (axisymmetric phase-change paper §3.2) t = 10 s, h = R/40 … R/320: max nodal error at r ≥ R/10 {} K, rates {rb:.3?}; at the centre {} K, rates {rc:.3?}",
         sci(&bulk),
         sci(&centre)
     );
@@ -1098,12 +923,12 @@ fn sphere_converges_at_second_order() {
     );
 }
 
-/// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names.
-/// The pipe section of seed 001 §3.4 on quads of 0.04 m solved on the quads of 0.02 m: the
-/// other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long, the
-/// insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
-/// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's
-/// region, or `mesh` on a box case, is refused with one line naming the file and the key.
+/// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names. The pipe
+/// section of the axisymmetric phase-change paper §3.4 on quads of 0.04 m solved on the quads of
+/// 0.02 m: the other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long,
+/// the insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
+/// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's region, or
+/// `mesh` on a box case, is refused with one line naming the file and the key.
 #[test]
 fn reference_fem_mesh_solves_on_another_mesh() {
     let text = std::fs::read_to_string(root().join("cases/pipe_heating_2d.toml"))
@@ -1154,6 +979,7 @@ fn reference_fem_mesh_solves_on_another_mesh() {
     for (text, what) in bad {
         let path = PathBuf::from(write_case(
             dir.path(),
+            "case.toml",
             &text.replace("\"../meshes/", &meshes),
         ));
         let o = peritherm(&[

@@ -2,13 +2,14 @@
 //! size and an SVG with its labels, colours land where the values are, bad data is a typed
 //! error; and `peritherm plot` on small 2D and 3D runs.
 
+use crate::common::case::CaseToml;
+use crate::common::cli::peritherm;
 use peritherm::math::{Point, Vector};
 use peritherm::plot::{
     convergence_plot, field_map, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
 use peritherm::Error;
 use std::path::Path;
-use std::process::Command;
 
 /// Width and height from a PNG's IHDR chunk, after checking the signature.
 fn png_size(path: &Path) -> (u32, u32) {
@@ -217,45 +218,36 @@ fn bad_input_is_a_typed_error() {
     assert!(is_plot(line_plot(&nowhere, &labels, &good, Legend::None)).contains("png"));
 }
 
-const SMALL: &str = r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-thickness = 0.1
-[[region]]
-name = "left"
-min = [0.0, 0.0]
-max = [0.5, 0.5]
-spacing = 0.05
-horizon = { factor = 3.0 }
-[[region]]
-name = "right"
-min = [0.5, 0.0]
-max = [1.0, 0.5]
-spacing = 0.05
-horizon = { factor = 3.0 }
-[material.steel]
-conductivity = 50.0
-density = 7850.0
-specific_heat = 420.0
-[[crack]]
-points = [[0.3, 0.25], [0.7, 0.25]]
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = 100.0
-[time]
-end = 200.0
-outputs = [100.0, 200.0]
-"#;
-
-/// Runs the binary.
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
+/// A steel plate 1 × 0.5 of two regions, held at 100 °C on the left: in 2D (thickness 0.1)
+/// with a crack, to t = 200 s; in 3D (0.2 thick), uncracked, to t = 1 s.
+fn small(dim: usize) -> String {
+    let corners = |x: f64, y: f64| {
+        if dim == 2 {
+            format!("[{x:?}, {y:?}]")
+        } else {
+            format!("[{x:?}, {y:?}, {:?}]", if y > 0.0 { 0.2 } else { 0.0 })
+        }
+    };
+    let mut c = CaseToml::new(dim).domain(&corners(0.0, 0.0), &corners(1.0, 0.5));
+    if dim == 2 {
+        c = c.domain_key("thickness = 0.1");
+    }
+    c = c
+        .region("left", "spacing = 0.05", 3.0)
+        .region_key(&format!("min = {}", corners(0.0, 0.0)))
+        .region_key(&format!("max = {}", corners(0.5, 0.5)))
+        .region("right", "spacing = 0.05", 3.0)
+        .region_key(&format!("min = {}", corners(0.5, 0.0)))
+        .region_key(&format!("max = {}", corners(1.0, 0.5)))
+        .material("steel", 50.0, 7850.0, 420.0);
+    if dim == 2 {
+        c = c.section("[[crack]]\npoints = [[0.3, 0.25], [0.7, 0.25]]");
+    }
+    c = c.section("[boundary.x_min]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 100.0");
+    if dim == 2 {
+        c = c.end(200.0).time_key("outputs = [100.0, 200.0]");
+    }
+    c.text()
 }
 
 /// `peritherm plot` on a cracked 2D run writes temperature and damage maps per output; on a
@@ -264,7 +256,7 @@ fn peritherm(args: &[&str]) -> std::process::Output {
 fn cli_plot_writes_maps_and_refuses_3d() {
     let dir = tempfile::tempdir().unwrap();
     let case = dir.path().join("small.toml");
-    std::fs::write(&case, SMALL).unwrap();
+    std::fs::write(&case, small(2)).unwrap();
     let out = dir.path().join("out");
     let o = peritherm(&[
         "run",
@@ -286,16 +278,7 @@ fn cli_plot_writes_maps_and_refuses_3d() {
     }
 
     let case3 = dir.path().join("cube.toml");
-    let cube = SMALL
-        .replace("dimension = 2", "dimension = 3")
-        .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
-        .replace("[0.5, 0.0]", "[0.5, 0.0, 0.0]")
-        .replace("[0.5, 0.5]", "[0.5, 0.5, 0.2]")
-        .replace("[1.0, 0.5]", "[1.0, 0.5, 0.2]")
-        .replace("thickness = 0.1\n", "")
-        .replace("[[crack]]\npoints = [[0.3, 0.25], [0.7, 0.25]]\n", "")
-        .replace("end = 200.0\noutputs = [100.0, 200.0]", "end = 1.0");
-    std::fs::write(&case3, cube).unwrap();
+    std::fs::write(&case3, small(3)).unwrap();
     let out3 = dir.path().join("out3");
     let o = peritherm(&[
         "run",

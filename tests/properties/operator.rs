@@ -2,48 +2,28 @@
 //! and the explicit stability bound.
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::weights::Order;
-use std::path::Path;
 
 /// A two-region dual-horizon plate 2 × 1: k = Δ1/Δ2 = 0.5, m = δ1/δ2 = 2/3 (so neither
 /// spacing nor horizon is uniform), free (insulated) surfaces.
 fn dual_horizon_case(faces: &str, calibration: &str) -> Case {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [2.0, 1.0]
-thickness = 0.1
-[[region]]
-name = "fine"
-max = [0.8, 1.0]
-spacing = 0.025
-horizon = {{ factor = 4.0 }}
-[[region]]
-name = "coarse"
-min = [0.8, 0.0]
-spacing = 0.05
-horizon = {{ factor = 3.0 }}
-[material.m]
-conductivity = 2.0
-density = 300.0
-specific_heat = 0.5
-[kernel]
-p = 1
-calibration = "{calibration}"
-{faces}
-[initial]
-value = "sin(7*x) + 3*cos(5*y) + x*y"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    Case::parse(&text, Path::new("dual_horizon.toml")).unwrap()
+    CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[2.0, 1.0]")
+        .domain_key("thickness = 0.1")
+        .region("fine", "spacing = 0.025", 4.0)
+        .region_key("max = [0.8, 1.0]")
+        .region("coarse", "spacing = 0.05", 3.0)
+        .region_key("min = [0.8, 0.0]")
+        .material("m", 2.0, 300.0, 0.5)
+        .section(&format!("[kernel]\np = 1\ncalibration = \"{calibration}\""))
+        .section(faces)
+        .initial("sin(7*x) + 3*cos(5*y) + x*y")
+        .time_key("integrator = \"euler\"")
+        .case("dual_horizon.toml")
 }
 
 /// Energy Σ V ρc θ stays constant over 1000 Euler steps on an insulated, non-uniform,
@@ -453,7 +433,7 @@ fn neighbour_search_grid_equals_tree() {
     assert_eq!(a.targets, model.horizons.targets);
 }
 
-/// The Gershgorin bound of formulation §4 is safe and not far from the truth: Euler at the
+/// The Gershgorin bound of theory §4 is safe and not far from the truth: Euler at the
 /// bound stays bounded; Euler at 1.2× the true limit 2/λ_max (power iteration) blows up;
 /// a user Δt above the bound is refused with the bound in the message.
 #[test]
@@ -568,33 +548,16 @@ fn linear_consistency_correction_is_exact_and_conservative() {
 /// K is symmetric and an RK4 run conserves energy (tolerance 1e-12 relative).
 #[test]
 fn three_dimensional_boxes_conserve_energy() {
-    let text = r#"
-dimension = 3
-[domain]
-min = [0.0, 0.0, 0.0]
-max = [0.4, 0.2, 0.2]
-[[region]]
-name = "fine"
-max = [0.2, 0.2, 0.2]
-spacing = 0.02
-horizon = { factor = 3.0 }
-[[region]]
-name = "coarse"
-min = [0.2, 0.0, 0.0]
-spacing = 0.04
-horizon = { factor = 2.0 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-profile = "conical"
-[initial]
-value = "x*x + sin(20*y) + z"
-[time]
-end = 1.0
-"#;
-    let m = Model::build(&Case::parse(text, Path::new("box.toml")).unwrap().spec).unwrap();
+    let m = CaseToml::new(3)
+        .domain("[0.0, 0.0, 0.0]", "[0.4, 0.2, 0.2]")
+        .region("fine", "spacing = 0.02", 3.0)
+        .region_key("max = [0.2, 0.2, 0.2]")
+        .region("coarse", "spacing = 0.04", 2.0)
+        .region_key("min = [0.2, 0.0, 0.0]")
+        .material("m", 1.0, 1.0, 1.0)
+        .section("[kernel]\nprofile = \"conical\"")
+        .initial("x*x + sin(20*y) + z")
+        .model("box.toml");
     assert!((m.cloud.body_volume() - 0.4 * 0.2 * 0.2).abs() < 1e-15);
     assert_eq!(m.cloud.n_body, 10 * 10 * 10 + 5 * 5 * 5);
     let k = &m.conductance;

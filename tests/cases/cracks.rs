@@ -1,5 +1,5 @@
-//! Cracks: bond cutting, damage, the heat-flux vector, and the seed 003 crack plate against
-//! an independent finite-difference solution.
+//! Cracks: bond cutting, damage, the heat-flux vector, and the Bobaru & Duangpanya 2012 crack plate
+//! against an independent finite-difference solution.
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
 use peritherm::case::Case;
@@ -7,15 +7,16 @@ use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::PathBuf;
 
-mod common;
-use common::fd::CrackPlate;
+use crate::common::case::CaseToml;
+use crate::common::fd::CrackPlate;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn case(text: &str) -> Case {
-    Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+/// Where the test cases pretend to live (relative paths in them resolve from `cases/`).
+fn in_cases() -> PathBuf {
+    root().join("cases/test.toml")
 }
 
 /// The body node at (x, y, z) (within 1e-9 m).
@@ -36,35 +37,24 @@ fn run_steps(model: &Model, steps: usize, dt: f64) -> Vec<f64> {
     theta
 }
 
+/// The unit square (Δ = 0.02, δ = 3Δ), k = ρc = 1, with an explicit Euler time loop.
+fn unit_square() -> CaseToml {
+    CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 1.0]")
+        .region("r", "spacing = 0.02", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .time_key("integrator = \"euler\"")
+}
+
 fn halves(conductance: f64, correction: bool) -> (f64, f64, f64) {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.02
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-crack_correction = {correction}
-[[crack]]
-points = [[-0.5, 0.5003], [0.4, 0.5003], [1.5, 0.5003]]
-conductance = {conductance}
-[initial]
-value = "y > 0.5"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    let c = case(&text);
-    let model = Model::build(&c.spec).unwrap();
+    let model = unit_square()
+        .section(&format!(
+            "[kernel]\ncrack_correction = {correction}\n\
+             [[crack]]\npoints = [[-0.5, 0.5003], [0.4, 0.5003], [1.5, 0.5003]]\n\
+             conductance = {conductance}"
+        ))
+        .initial("y > 0.5")
+        .model(in_cases());
     let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
     let theta = run_steps(&model, 500, dt);
     let energy_of = |th: &[f64], upper: bool| -> f64 {
@@ -95,28 +85,7 @@ fn an_insulated_crack_splits_the_body() {
     }
 }
 
-const LINEAR: &str = r#"
-dimension = DIM
-[domain]
-min = MIN
-max = MAX
-[[region]]
-name = "r"
-spacing = 0.05
-horizon = { factor = 3 }
-[material.m]
-conductivity = 2.5
-density = 1.0
-specific_heat = 1.0
-[kernel]
-calibration = "lattice"
-[initial]
-value = "3 + 2*x - 5*y + 7*z"
-[time]
-end = 1.0
-"#;
-
-/// The PD heat flux (formulation §8) equals −k∇θ for a linear field at every bulk node
+/// The PD heat flux (theory §8) equals −k∇θ for a linear field at every bulk node
 /// (horizon clear of the free faces), in 2D and 3D. Tolerance 1e-10 relative: with the
 /// lattice calibration the half-horizon moment is k exactly, leaving round-off.
 #[test]
@@ -125,11 +94,13 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
         (2, "[0.0, 0.0]", "[1.0, 1.0]"),
         (3, "[0.0, 0.0, 0.0]", "[0.5, 0.5, 0.5]"),
     ] {
-        let text = LINEAR
-            .replace("DIM", &dim.to_string())
-            .replace("MIN", min)
-            .replace("MAX", max);
-        let model = Model::build(&case(&text).spec).unwrap();
+        let model = CaseToml::new(dim)
+            .domain(min, max)
+            .region("r", "spacing = 0.05", 3.0)
+            .material("m", 2.5, 1.0, 1.0)
+            .section("[kernel]\ncalibration = \"lattice\"")
+            .initial("3 + 2*x - 5*y + 7*z")
+            .model(in_cases());
         let q = model.conductance.flux(&model.cloud, &model.theta0);
         let grad = [2.0, -5.0, if dim == 3 { 7.0 } else { 0.0 }];
         let c = &model.cloud;
@@ -157,24 +128,23 @@ fn flux_is_minus_k_grad_theta_for_a_linear_field() {
     }
 }
 
-/// The bundled seed 003 Example 3 crack plate (with the crack correction) against the
-/// classical solution of the same problem (finite differences on 3 × 3 cells per PD node, so
-/// that every node sits on a cell centre; `common::fd`), at every node outside the 2δ discs
-/// around the crack tips:
+/// The bundled Bobaru & Duangpanya 2012 Example 3 crack plate (with the crack correction) against
+/// the classical solution of the same problem (finite differences on 3 × 3 cells per PD node, so
+/// that every node sits on a cell centre; `common::fd`), at every node outside the 2δ discs around
+/// the crack tips:
 /// - at 0.5 s against the classical transient at 0.5 s: within 1 °C (measured 0.45 °C);
 /// - run on to its steady state (3 s) against the classical steady solution: within 1 °C
 ///   (measured 0.48 °C; without the crack correction 2.22 °C, beside the crack faces).
 ///
-/// The 1 °C bound is about twice the PD discretisation error at δ = 13L/240 (seed 003's
-/// own figures show differences of this size against ABAQUS). The paper calls 0.5 s
-/// steady; it is not quite: the classical solution itself still moves by more than 2 °C
-/// between 0.5 s and its steady state at the middle of the crack faces, which this test also
-/// checks so that the transient-to-transient comparison stays justified.
-/// The gmsh refined-zone crack plate (cases/crack_plate_refined.toml: default triangles,
-/// consistent bond weights, crack correction) against the classical solution at 0.5 s
-/// (finite differences as above) outside the 2δ discs around the crack tips (δ = 3 × 1.25e-4
-/// m there): within 0.5 °C (the lattice plates are within 0.47–0.76 °C; this mesh was
-/// 1.07 °C with the kernel's own weights). Measured 0.234 °C.
+/// The 1 °C bound is about twice the PD discretisation error at δ = 13L/240 (Bobaru & Duangpanya
+/// 2012's own figures show differences of this size against ABAQUS). The paper calls 0.5 s steady;
+/// it is not quite: the classical solution itself still moves by more than 2 °C between 0.5 s and
+/// its steady state at the middle of the crack faces, which this test also checks so that the
+/// transient-to-transient comparison stays justified. The gmsh refined-zone crack plate
+/// (cases/crack_plate_refined.toml: default triangles, consistent bond weights, crack correction)
+/// against the classical solution at 0.5 s (finite differences as above) outside the 2δ discs
+/// around the crack tips (δ = 3 × 1.25e-4 m there): within 0.5 °C (the lattice plates are within
+/// 0.47–0.76 °C; this mesh was 1.07 °C with the kernel's own weights). Measured 0.234 °C.
 ///
 /// Triangle centroids do not sit on finite-difference cell centres, so the reference is
 /// interpolated bilinearly between cell centres (never across the crack). Taking the nearest
@@ -293,38 +263,19 @@ fn crack_plate_matches_finite_differences() {
     }
 }
 
-const GROWING: &str = r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.02
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[0.0, 0.5003], [0.6, 0.5003], [1.0, 0.5003]]
-speed = 0.1
-start = 0.2
-initial_length = 0.1
-[initial]
-value = "y > 0.5"
-[time]
-end = 1.0
-integrator = "euler"
-"#;
-
 /// A growing crack cuts each pair when its tip passes the crossing point: at
 /// start + (x_cross − initial_length)/speed, pairs crossing the initial length at once,
 /// pairs the tip never reaches never. The stepper cuts them in place at that moment, K
 /// stays symmetric, and energy is conserved to round-off across the cuts.
 #[test]
 fn growing_crack_cuts_bonds_when_its_tip_passes() {
-    let model = Model::build(&case(GROWING).spec).unwrap();
+    let model = unit_square()
+        .section(
+            "[[crack]]\npoints = [[0.0, 0.5003], [0.6, 0.5003], [1.0, 0.5003]]\n\
+             speed = 0.1\nstart = 0.2\ninitial_length = 0.1",
+        )
+        .initial("y > 0.5")
+        .model(in_cases());
     let c = &model.cloud;
     assert!(!model.growth.is_empty());
     let k0 = &model.conductance;
@@ -393,25 +344,15 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
 /// and zero beside it, and a node pair straddling it has K = 0.
 #[test]
 fn a_planar_polygon_cuts_3d_bonds() {
-    let text = r#"
-dimension = 3
-[domain]
-min = [0.0, 0.0, 0.0]
-max = [1.0, 1.0, 1.0]
-[[region]]
-name = "r"
-spacing = 0.1
-horizon = { factor = 2 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[[crack]]
-points = [[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]
-[time]
-end = 1.0
-"#;
-    let model = Model::build(&case(text).spec).unwrap();
+    let cube = |points: &str| {
+        CaseToml::new(3)
+            .domain("[0.0, 0.0, 0.0]", "[1.0, 1.0, 1.0]")
+            .region("r", "spacing = 0.1", 2.0)
+            .material("m", 1.0, 1.0, 1.0)
+            .section(&format!("[[crack]]\npoints = {points}"))
+    };
+    let model = cube("[[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.5]]")
+        .model(in_cases());
     let find = |x: f64, y: f64, z: f64| node_at(&model, x, y, z);
     let (a, b) = (find(0.35, 0.45, 0.45), find(0.35, 0.45, 0.55));
     assert_eq!(model.conductance.get(a, b), 0.0);
@@ -420,20 +361,20 @@ end = 1.0
     let d = model.damage_at(0.0);
     assert!(d[a] > 0.2, "damage {}", d[a]);
     assert_eq!(d[a2], 0.0);
-    let bad = text.replace("[0.2, 0.6, 0.5]]", "[0.2, 0.6, 0.7]]");
-    let e = Case::parse(&bad, &root().join("cases/test.toml"))
+    let bad = cube("[[0.2, 0.2, 0.5], [0.6, 0.2, 0.5], [0.6, 0.6, 0.5], [0.2, 0.6, 0.7]]");
+    let e = Case::parse(&bad.text(), &in_cases())
         .unwrap_err()
         .to_string();
     assert!(e.contains("crack[0].points") && e.contains("planar"), "{e}");
 }
 
-/// Seed 004 §4.3: the dual-horizon crack plate with a coarse outer region ((k, m) = (2, 1),
-/// 25000 nodes) agrees with the classical solution at 0.5 s (finite differences, bilinear
-/// between cell centres, never across the crack) as well as the uniform fine run ((1, 1),
-/// 40000 nodes) does, outside the 2δ discs around the crack tips: both within 1 °C
-/// (measured 0.38 and 0.37 °C, the PD discretisation at δ = 3Δ beside the crack faces; the
-/// bound is the one of `crack_plate_matches_finite_differences`), and within 0.2 °C of each
-/// other (measured 0.09 °C, at the region interface).
+/// Wang, Oterkus & Oterkus (dual-horizon paper) §4.3: the dual-horizon crack plate with a coarse
+/// outer region ((k, m) = (2, 1), 25000 nodes) agrees with the classical solution at 0.5 s (finite
+/// differences, bilinear between cell centres, never across the crack) as well as the uniform fine
+/// run ((1, 1), 40000 nodes) does, outside the 2δ discs around the crack tips: both within 1 °C
+/// (measured 0.38 and 0.37 °C, the PD discretisation at δ = 3Δ beside the crack faces; the bound is
+/// the one of `crack_plate_matches_finite_differences`), and within 0.2 °C of each other (measured
+/// 0.09 °C, at the region interface).
 #[test]
 fn dual_horizon_crack_plate_matches_finite_differences() {
     let plate = CrackPlate {

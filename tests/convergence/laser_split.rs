@@ -2,8 +2,9 @@
 //! horizon peridynamics, at a coarse resolution: the laser-heated film (§4.4,
 //! `cases/laser_film.toml`) and the thermal shock with a split initial field (§4.5,
 //! `cases/thermal_shock_split.toml`), each against its classical series (checked against
-//! finite differences in tests/series.rs), the split plate also against the built-in FEM,
-//! and the report of each (history plots, probe lines). Each test states its tolerance.
+//! finite differences in tests/convergence/series.rs), the split plate also against the
+//! built-in FEM, and the report of each (history plots, probe lines). Each test states its
+//! tolerance.
 
 use peritherm::case::Case;
 use peritherm::fem::run_fem;

@@ -5,9 +5,7 @@
 //!
 //! `PERITHERM_FUZZ_INPUTS` and `PERITHERM_FUZZ_START` (a generator state) explore further.
 
-mod common;
-
-use common::hostile::{mutate, Rng, PLATE};
+use crate::common::hostile::{mutate, Rng, PLATE};
 use peritherm::case::Case;
 use peritherm::prepare::{build, plan, Options};
 use std::path::{Path, PathBuf};

@@ -4,6 +4,7 @@
 //! the case-file errors of the `[mesh]` schema.
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::cloud::mesh::{MeshGeometry, MeshRegion};
 use peritherm::cloud::{Cloud, HorizonRule};
@@ -41,10 +42,9 @@ fn cloud_of(file: &Path, tau: f64) -> Cloud {
     geometry.generate(&[], 0.0).unwrap()
 }
 
-/// A case text with the given body, kernel and boundary sections, parsed as if it lived
-/// in `cases/` (so mesh paths read `../meshes/...`).
-fn case(text: &str) -> Case {
-    Case::parse(text, &root().join("cases/test.toml")).unwrap_or_else(|e| panic!("{e}"))
+/// Where the test cases pretend to live: in `cases/`, so mesh paths read `../meshes/...`.
+fn in_cases() -> PathBuf {
+    root().join("cases/test.toml")
 }
 
 fn case_error(text: &str) -> String {
@@ -156,45 +156,34 @@ fn gmsh_quads_reproduce_the_box_generator() {
     assert!(worst < 1e-9, "max difference {worst:e} °C");
 }
 
-const GRADED_CRACKED: &str = r#"
-dimension = 2
-[mesh]
-file = "../meshes/crack_plate_refined.msh"
-thickness = 1e-4
-horizon_ratio = 1.3
-[[region]]
-name = "zone"
-horizon = { factor = 3 }
-[[region]]
-name = "far"
-horizon = { factor = 4 }
-[material.m]
-conductivity = 114.0
-density = 1e6
-specific_heat = 1.0
-[[crack]]
-group = "crack"
-[boundary.top]
-type = "free"
-[boundary.bottom]
-type = "free"
-[boundary.left]
-type = "free"
-[boundary.right]
-type = "free"
-[initial]
-value = "100*sin(300*x) + 50*cos(200*y) + 1e4*x*y"
-[time]
-end = 1.0
-integrator = "euler"
-"#;
+/// The refined crack plate mesh, insulated, with the crack; horizons graded by
+/// `mesh.horizon_ratio = 1.3` when `graded`.
+fn graded_cracked(graded: bool) -> Case {
+    let mut c = CaseToml::new(2)
+        .mesh("../meshes/crack_plate_refined.msh")
+        .mesh_key("thickness = 1e-4");
+    if graded {
+        c = c.mesh_key("horizon_ratio = 1.3");
+    }
+    c.region("zone", "", 3.0)
+        .region("far", "", 4.0)
+        .material("m", 114.0, 1e6, 1.0)
+        .section("[[crack]]\ngroup = \"crack\"")
+        .section(
+            "[boundary.top]\ntype = \"free\"\n[boundary.bottom]\ntype = \"free\"\n\
+             [boundary.left]\ntype = \"free\"\n[boundary.right]\ntype = \"free\"",
+        )
+        .initial("100*sin(300*x) + 50*cos(200*y) + 1e4*x*y")
+        .time_key("integrator = \"euler\"")
+        .case(in_cases())
+}
 
 /// Energy is conserved to 1e-12 relative over 1000 Euler steps on an insulated gmsh cloud
 /// whose horizon varies node to node (graded, two horizon rules) and which has a crack:
 /// K stays symmetric bit for bit, so the bond sum cancels pairwise up to summation round-off.
 #[test]
 fn energy_is_conserved_on_a_graded_cracked_cloud() {
-    let c = case(GRADED_CRACKED);
+    let c = graded_cracked(true);
     let model = Model::build(&c.spec).unwrap();
     let (lo, hi) = model.cloud.horizon[..model.cloud.n_body]
         .iter()
@@ -223,21 +212,11 @@ fn energy_is_conserved_on_a_graded_cracked_cloud() {
 /// insulated through mirrored layers by default: their fictitious nodes lie in the notch.)
 #[test]
 fn no_bond_crosses_the_re_entrant_notch() {
-    let text = r#"
-dimension = 2
-[mesh]
-file = "../meshes/l_shape.msh"
-[[region]]
-name = "plate"
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[time]
-end = 1.0
-"#;
-    let model = Model::build(&case(text).spec).unwrap();
+    let model = CaseToml::new(2)
+        .mesh("../meshes/l_shape.msh")
+        .region("plate", "", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .model(in_cases());
     let c = &model.cloud;
     let in_notch = |p: &peritherm::math::Point| p.x > 0.01 + 1e-9 && p.y > 0.01 + 1e-9;
     let crosses = |i: usize, j: usize| {
@@ -346,22 +325,12 @@ end = 1.0
 /// and each belongs to a node of the element behind the facet (tolerance: round-off).
 #[test]
 fn exposed_areas_add_up_to_the_boundary() {
-    let text = r#"
-dimension = 2
-[mesh]
-file = "../meshes/l_shape.msh"
-thickness = 0.003
-[[region]]
-name = "plate"
-horizon = { factor = 3 }
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[time]
-end = 1.0
-"#;
-    let model = Model::build(&case(text).spec).unwrap();
+    let model = CaseToml::new(2)
+        .mesh("../meshes/l_shape.msh")
+        .mesh_key("thickness = 0.003")
+        .region("plate", "", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .model(in_cases());
     let peritherm::cloud::Sides::Mesh(sides) = &model.cloud.sides else {
         panic!("a mesh cloud")
     };
@@ -389,10 +358,8 @@ end = 1.0
 /// of its nearest neighbours, and no δ grows (the grading only lowers coarse horizons).
 #[test]
 fn horizon_grading_limits_the_ratio_between_neighbours() {
-    let graded = Model::build(&case(GRADED_CRACKED).spec).unwrap().cloud;
-    let plain = Model::build(&case(&GRADED_CRACKED.replace("horizon_ratio = 1.3\n", "")).spec)
-        .unwrap()
-        .cloud;
+    let graded = Model::build(&graded_cracked(true).spec).unwrap().cloud;
+    let plain = Model::build(&graded_cracked(false).spec).unwrap().cloud;
     let index = peritherm::spatial::PointIndex::new(&graded.pos[..graded.n_body]);
     let mut lowered = 0;
     for i in 0..graded.n_body {
@@ -437,40 +404,28 @@ fn linear_fields_are_steady_on_mesh_clouds() {
         ),
     ];
     for (file, dim, region, lo, hi, ins1, ins2) in setups {
-        let mut text = format!(
-            r#"
-dimension = {dim}
-[mesh]
-file = "../tests/data/{file}"
-[[region]]
-name = "{region}"
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 2.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-calibration = "lattice"
-linear_consistency = {}
-[initial]
-value = "3 + 10*x"
-[time]
-end = 1.0
-integrator = "euler"
-"#,
-            dim == 2
-        );
+        let mut text = CaseToml::new(dim)
+            .mesh(&format!("../tests/data/{file}"))
+            .region(region, "", 3.0)
+            .material("m", 2.0, 1.0, 1.0)
+            .section(&format!(
+                "[kernel]\ncalibration = \"lattice\"\nlinear_consistency = {}",
+                dim == 2
+            ))
+            .initial("3 + 10*x")
+            .time_key("integrator = \"euler\"");
         for (set, kind) in [(lo, "hold"), (hi, "hold"), (ins1, "ins"), (ins2, "ins")] {
             if set.is_empty() {
                 continue;
             }
-            text += &if kind == "hold" {
+            text = text.section(&if kind == "hold" {
                 format!("[boundary.{set}]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = \"3 + 10*x\"\n")
             } else {
                 format!("[boundary.{set}]\ntype = \"insulated\"\n")
-            };
+            });
         }
-        let model = Model::build(&case(&text).spec).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let model =
+            Model::build(&text.case(in_cases()).spec).unwrap_or_else(|e| panic!("{file}: {e}"));
         let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
         let theta = run_steps(&model, 1, dt);
         let worst = (0..model.cloud.n_body)

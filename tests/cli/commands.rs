@@ -1,7 +1,8 @@
 //! The command line as a user meets it: the output contract and bad input.
 
+use crate::common::case::CaseToml;
+use crate::common::cli::{command, peritherm, write_case};
 use std::path::Path;
-use std::process::Command;
 
 const SMALL: &str = r#"
 dimension = 2
@@ -41,19 +42,6 @@ const SPLIT: &str = "[reference.solution]\nkind = \"plate_pulse_split\"\nx0 = 0.
 
 /// A `film_laser_pulse` reference with a reflectivity above 1.
 const LASER: &str = "[reference.solution]\nkind = \"film_laser_pulse\"\nx0 = 0.0\nlength = 1.0\ndiffusivity = 1.5e-5\nheat_capacity = 3.3e6\nfluence = 13.4\nreflectivity = 1.5\ndepth = 0.1\nduration = 0.1\nshape = 2.0\n";
-
-fn peritherm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_peritherm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn write_case(dir: &Path, name: &str, text: &str) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p.display().to_string()
-}
 
 /// field_<k>.csv has x,y,z,temperature and one row per body node; run.json has the keys.
 #[test]
@@ -309,33 +297,20 @@ fn gmsh_cases_run_compare_and_refuse_bad_meshes() {
     let dir = tempfile::tempdir().unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mesh = root.join("meshes/l_shape.msh");
-    let text = format!(
-        r#"
-dimension = 2
-[mesh]
-file = "{}"
-[[region]]
-name = "plate"
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[boundary.left]
-type = "temperature"
-method = "mirror"
-value = 10.0
-[boundary.top]
-type = "convection"
-h = 100.0
-ambient = 0.0
-[time]
-end = 1e-6
-outputs = [5e-7, 1e-6]
-"#,
-        mesh.display()
-    );
-    let case = write_case(dir.path(), "l.toml", &text);
+    let l_shape = |mesh: &Path| {
+        CaseToml::new(2)
+            .mesh(&mesh.display().to_string())
+            .region("plate", "", 3.0)
+            .material("m", 1.0, 1.0, 1.0)
+            .section(
+                "[boundary.left]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 10.0\n\
+                 [boundary.top]\ntype = \"convection\"\nh = 100.0\nambient = 0.0",
+            )
+            .end(1e-6)
+            .time_key("outputs = [5e-7, 1e-6]")
+            .text()
+    };
+    let case = write_case(dir.path(), "l.toml", &l_shape(&mesh));
     let out = dir.path().join("out");
     let o = peritherm(&["run", &case, "--out", out.to_str().unwrap(), "-q"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -353,11 +328,7 @@ outputs = [5e-7, 1e-6]
     let broken = dir.path().join("broken.msh");
     let bytes = std::fs::read(&mesh).unwrap();
     std::fs::write(&broken, &bytes[..bytes.len() / 2]).unwrap();
-    let bad = write_case(
-        dir.path(),
-        "bad.toml",
-        &text.replace(&mesh.display().to_string(), &broken.display().to_string()),
-    );
+    let bad = write_case(dir.path(), "bad.toml", &l_shape(&broken));
     let out2 = dir.path().join("out2");
     let o = peritherm(&["run", &bad, "--out", out2.to_str().unwrap()]);
     assert!(!o.status.success());
@@ -370,10 +341,10 @@ outputs = [5e-7, 1e-6]
     assert!(!out2.exists(), "no output for a failed run");
 }
 
-/// `peritherm sweep` over the horizon of the seed 000 bar (δ halved twice at fixed Δ, to
-/// t = 0.1 s) writes one row per variant and output, and the max difference to the series
-/// falls as δ falls (the δ-convergence of seed 000 Fig. 10, measured 31.2 → 15.2 → 5.3 °C
-/// at t = 0.1 s, where the steep initial layer makes the error large). Against the first
+/// `peritherm sweep` over the horizon of the Bobaru & Duangpanya 2010 bar (δ halved twice at fixed
+/// Δ, to t = 0.1 s) writes one row per variant and output, and the max difference to the series
+/// falls as δ falls (the δ-convergence of Bobaru & Duangpanya 2010 Fig. 10, measured 31.2 → 15.2 →
+/// 5.3 °C at t = 0.1 s, where the steep initial layer makes the error large). Against the first
 /// variant instead, that variant's own row is zero.
 #[test]
 fn sweep_writes_a_table_and_converges_in_delta() {
@@ -453,51 +424,26 @@ fn sweep_writes_a_table_and_converges_in_delta() {
 fn report_writes_plots_pages_and_an_index() {
     let dir = tempfile::tempdir().unwrap();
     let square = |crack: &str| {
-        format!(
-            r#"
-title = "small square"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "square"
-cells = [16, 16]
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.14
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = 0.0
-[boundary.x_max]
-type = "temperature"
-value = 0.0
-[boundary.y_min]
-type = "temperature"
-value = 0.0
-[boundary.y_max]
-type = "temperature"
-value = 0.0
-{crack}
-[initial]
-value = 40.0
-[time]
-end = 0.02
-outputs = [0.01, 0.02]
-[reference]
-line_y = 0.46875
-[reference.solution]
-kind = "square_fixed_edges"
-x0 = 0.0
-y0 = 0.0
-length = 1.0
-diffusivity = 1.14
-edge = 0.0
-initial = 40.0
-"#
-        )
+        let mut c = CaseToml::new(2)
+            .key("title = \"small square\"")
+            .domain("[0.0, 0.0]", "[1.0, 1.0]")
+            .region("square", "cells = [16, 16]", 3.0)
+            .material("m", 1.14, 1.0, 1.0);
+        for face in ["x_min", "x_max", "y_min", "y_max"] {
+            c = c.section(&format!(
+                "[boundary.{face}]\ntype = \"temperature\"\nvalue = 0.0"
+            ));
+        }
+        c.section(crack)
+            .section(
+                "[reference]\nline_y = 0.46875\n\
+                 [reference.solution]\nkind = \"square_fixed_edges\"\nx0 = 0.0\ny0 = 0.0\n\
+                 length = 1.0\ndiffusivity = 1.14\nedge = 0.0\ninitial = 40.0",
+            )
+            .initial_value(40.0)
+            .end(0.02)
+            .time_key("outputs = [0.01, 0.02]")
+            .text()
     };
     let a = write_case(dir.path(), "plain.toml", &square(""));
     let b = write_case(
@@ -555,13 +501,7 @@ fn compare_and_plot_work_from_any_directory() {
     std::fs::copy(root.join("meshes/l_shape.msh"), work.join("meshes/l.msh")).unwrap();
     let text = "dimension = 2\n[mesh]\nfile = \"meshes/l.msh\"\n[[region]]\nname = \"plate\"\nhorizon = { factor = 3 }\n[material.m]\nconductivity = 1.0\ndensity = 1.0\nspecific_heat = 1.0\n[boundary.left]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 10.0\n[time]\nend = 1e-6\noutputs = [1e-6]\n";
     write_case(&work, "l.toml", text);
-    let run = |cwd: &Path, args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_peritherm"))
-            .current_dir(cwd)
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let run = |cwd: &Path, args: &[&str]| command().current_dir(cwd).args(args).output().unwrap();
     let o = run(&work, &["run", "l.toml", "--out", "out", "-q"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(

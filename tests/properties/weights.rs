@@ -3,7 +3,7 @@
 //! still stable. The meshes are meshes/moments_*.msh (triangles, unstructured quadrangles,
 //! mixed, graded 4×, tetrahedra; the hexahedra of moments_hex.msh are the open case below).
 
-use peritherm::case::Case;
+use crate::common::case::CaseToml;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::weights::Order;
@@ -41,30 +41,15 @@ fn model_on(
 ) -> Model {
     let (name, wall) = group;
     let consistency = order.map_or(String::new(), |o| format!("consistency = \"{o}\"\n"));
-    let text = format!(
-        r#"
-dimension = {dim}
-[mesh]
-file = "../meshes/{file}"
-[[region]]
-name = "body"
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 2.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-{consistency}
-[boundary.{name}]
-{wall}
-[initial]
-value = "{initial}"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    let case = Case::parse(&text, Path::new("tests/weights.toml")).unwrap();
+    let case = CaseToml::new(dim)
+        .mesh(&format!("../meshes/{file}"))
+        .region("body", "", 3.0)
+        .material("m", 2.0, 1.0, 1.0)
+        .section(&format!("[kernel]\n{consistency}"))
+        .section(&format!("[boundary.{name}]\n{wall}"))
+        .initial(initial)
+        .time_key("integrator = \"euler\"")
+        .case("tests/weights.toml");
     Model::build(&case.spec).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 
@@ -226,7 +211,8 @@ fn default_model(file: &Path) -> Result<Model, String> {
     }
     text += "[material.m]\nconductivity = 1.0\ndensity = 1.0\nspecific_heat = 1.0\n";
     text += "[initial]\nvalue = 1.0\n[time]\nend = 1.0\n";
-    let case = Case::parse(&text, Path::new("every_mesh.toml")).map_err(|e| e.to_string())?;
+    let case = peritherm::case::Case::parse(&text, Path::new("every_mesh.toml"))
+        .map_err(|e| e.to_string())?;
     Model::build(&case.spec).map_err(|e| e.to_string())
 }
 

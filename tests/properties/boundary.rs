@@ -1,39 +1,22 @@
-//! Exact invariants of the boundary conditions of formulation §3: each rule reproduces the
+//! Exact invariants of the boundary conditions of theory §3: each rule reproduces the
 //! field it is built for, and the loads add exactly the energy they should.
 
-use peritherm::case::Case;
+use crate::common::case::CaseToml;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{Explicit, Integrator};
-use std::path::Path;
 
 /// A 2D plate 1 × 0.5 (thickness 0.1) with the given boundary tables and initial field.
 fn plate(placement: &str, faces: &str, initial: &str) -> Model {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-thickness = 0.1
-placement = "{placement}"
-[[region]]
-name = "plate"
-spacing = 0.025
-horizon = {{ factor = 3.5 }}
-[material.m]
-conductivity = 2.0
-density = 4.0
-specific_heat = 0.5
-[kernel]
-calibration = "lattice"
-{faces}
-[initial]
-value = "{initial}"
-[time]
-end = 1.0
-"#
-    );
-    Model::build(&Case::parse(&text, Path::new("plate.toml")).unwrap().spec).unwrap()
+    CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 0.5]")
+        .domain_key("thickness = 0.1")
+        .domain_key(&format!("placement = \"{placement}\""))
+        .region("plate", "spacing = 0.025", 3.5)
+        .material("m", 2.0, 4.0, 0.5)
+        .section("[kernel]\ncalibration = \"lattice\"")
+        .section(faces)
+        .initial(initial)
+        .model("plate.toml")
 }
 
 /// Largest |Σ_j K_ij (θ_j − θ_i)| over free body nodes after the boundary is applied,
@@ -98,9 +81,9 @@ value = "2 + t"
     }
 }
 
-/// Seed 003 §3.2 nodal flux relation on nodes on the boundary: with the lattice calibration
-/// the inward half-horizon sum gives exactly k ∂θ/∂n, so the relation keeps a linear field
-/// with gradient q/k unchanged (tolerance 1e-12 relative).
+/// Bobaru & Duangpanya 2012 §3.2 nodal flux relation on nodes on the boundary: with the lattice
+/// calibration the inward half-horizon sum gives exactly k ∂θ/∂n, so the relation keeps a linear
+/// field with gradient q/k unchanged (tolerance 1e-12 relative).
 #[test]
 fn nodal_flux_relation_keeps_the_matching_linear_field() {
     let faces = r#"
@@ -131,30 +114,16 @@ value = 6.0
     assert!(n > 5);
 }
 
-/// Seed 000 eq 22 in 1D: the nodes within δ of the end follow the anchor with gradient q/k.
+/// Bobaru & Duangpanya 2010 eq 22 in 1D: the nodes within δ of the end follow the anchor with
+/// gradient q/k.
 #[test]
 fn bar_flux_relation_sets_the_gradient() {
-    let text = r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "bar"
-cells = [40]
-horizon = { factor = 4 }
-[material.m]
-conductivity = 2.0
-density = 1.0
-specific_heat = 1.0
-[boundary.x_max]
-type = "flux"
-method = "relation"
-value = 6.0
-[time]
-end = 1.0
-"#;
-    let m = Model::build(&Case::parse(text, Path::new("bar.toml")).unwrap().spec).unwrap();
+    let m = CaseToml::new(1)
+        .domain("[0.0]", "[1.0]")
+        .region("bar", "cells = [40]", 4.0)
+        .material("m", 2.0, 1.0, 1.0)
+        .section("[boundary.x_max]\ntype = \"flux\"\nmethod = \"relation\"\nvalue = 6.0")
+        .model("bar.toml");
     let mut theta = vec![5.0; m.cloud.len()];
     m.boundary.apply(&m.cloud, &mut theta, 0.0);
     let driven: Vec<usize> = (0..m.cloud.n_body)

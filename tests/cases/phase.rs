@@ -1,7 +1,9 @@
-//! Enthalpy form and phase change (formulation §6, seed 001): the enthalpy stepper against the
-//! linear one, energy conservation with phase change in symmetric bodies, and planar freezing
-//! against Neumann's solution.
+//! Enthalpy form and phase change (theory §6; the axisymmetric phase-change paper
+//! (doi:10.1007/s42102-022-00092-3)): the enthalpy stepper against the linear one, energy
+//! conservation with phase change in symmetric bodies, and planar freezing against Neumann's
+//! solution.
 
+use crate::common::case::CaseToml;
 use peritherm::analytic::{neumann_front, Reference};
 use peritherm::case::Case;
 use peritherm::model::Model;
@@ -9,86 +11,49 @@ use peritherm::solve::enthalpy::Enthalpic;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::Path;
 
-/// A material block; with `phase` a phase change that never happens (T_f far above every
-/// temperature, frozen properties equal to the melted ones), which switches the model to the
-/// enthalpy stepper without changing the physics.
-fn material(phase: bool) -> String {
-    let mut m =
-        String::from("[material.m]\nconductivity = 2.0\ndensity = 900.0\nspecific_heat = 1500.0\n");
-    if phase {
-        m.push_str(
-            "[material.m.phase_change]\ntemperature = 1e9\nlatent_heat = 3e5\n\
-             frozen_conductivity = 2.0\nfrozen_specific_heat = 1500.0\n",
-        );
-    }
-    m
-}
+/// With `phase` a phase change that never happens (T_f far above every temperature, frozen
+/// properties equal to the melted ones), which switches the model to the enthalpy stepper
+/// without changing the physics.
+const NO_PHASE_CHANGE: &str = "[material.m.phase_change]\ntemperature = 1e9\nlatent_heat = 3e5\n\
+                               frozen_conductivity = 2.0\nfrozen_specific_heat = 1500.0";
 
 /// Geometries covering every path of the stepper: planar 1D with mirror temperature and flux
 /// layers and a source; 2D axisymmetric with a free axis, mirror flux, mirror convection,
 /// surface convection and a nodal temperature.
-fn geometry(which: usize) -> &'static str {
+fn geometry(which: usize) -> CaseToml {
     match which {
-        0 => {
-            r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "body"
-spacing = 0.02
-horizon = { factor = 3.0 }
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = "20*(1 - exp(-t/50))"
-[boundary.x_max]
-type = "flux"
-value = 150.0
-[source]
-value = "2000*x"
-[initial]
-value = "5*sin(3*x)"
-"#
-        }
-        _ => {
-            r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [0.5, 0.4]
-[[region]]
-name = "body"
-spacing = 0.02
-horizon = { factor = 3.0 }
-[boundary.x_max]
-type = "flux"
-value = -300.0
-[boundary.y_min]
-type = "convection"
-method = "mirror"
-h = 40.0
-ambient = 30.0
-[boundary.y_max]
-type = "convection"
-h = 25.0
-ambient = -10.0
-[initial]
-value = "10*x + 20*y*y"
-"#
-        }
+        0 => CaseToml::new(1)
+            .domain("[0.0]", "[1.0]")
+            .region("body", "spacing = 0.02", 3.0)
+            .section(
+                "[boundary.x_min]\ntype = \"temperature\"\nmethod = \"mirror\"\n\
+                 value = \"20*(1 - exp(-t/50))\"\n\
+                 [boundary.x_max]\ntype = \"flux\"\nvalue = 150.0\n\
+                 [source]\nvalue = \"2000*x\"",
+            )
+            .initial("5*sin(3*x)"),
+        _ => CaseToml::new(2)
+            .key("symmetry = \"axisymmetric\"")
+            .domain("[0.0, 0.0]", "[0.5, 0.4]")
+            .region("body", "spacing = 0.02", 3.0)
+            .section(
+                "[boundary.x_max]\ntype = \"flux\"\nvalue = -300.0\n\
+                 [boundary.y_min]\ntype = \"convection\"\nmethod = \"mirror\"\nh = 40.0\n\
+                 ambient = 30.0\n\
+                 [boundary.y_max]\ntype = \"convection\"\nh = 25.0\nambient = -10.0",
+            )
+            .initial("10*x + 20*y*y"),
     }
 }
 
 fn case(which: usize, phase: bool) -> Case {
-    let text = format!(
-        "{}{}[time]\nend = 100.0\nintegrator = \"euler\"\n",
-        geometry(which),
-        material(phase)
-    );
-    Case::parse(&text, Path::new("enthalpy.toml")).unwrap()
+    let mut c = geometry(which).material("m", 2.0, 900.0, 1500.0);
+    if phase {
+        c = c.section(NO_PHASE_CHANGE);
+    }
+    c.end(100.0)
+        .time_key("integrator = \"euler\"")
+        .case("enthalpy.toml")
 }
 
 /// "Materials without phase change behave exactly as before": the enthalpy stepper on a
@@ -130,67 +95,39 @@ fn enthalpy_form_equals_the_linear_form_without_phase_change() {
 /// cancels pairwise; only summation round-off remains.
 #[test]
 fn energy_is_conserved_with_phase_change_in_symmetric_bodies() {
-    let water = r#"
-[material.water]
-conductivity = 0.6
-density = 1000.0
-specific_heat = 4182.0
-[material.water.phase_change]
-temperature = 0.0
-latent_heat = 333e3
-frozen_conductivity = 2.14
-frozen_specific_heat = 2060.0
-"#;
     let bodies = [
-        r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [0.1, 0.1]
-[[region]]
-name = "ice"
-max = [0.04, 0.04]
-spacing = 0.005
-horizon = { factor = 3.0 }
-initial = -5.0
-[[region]]
-name = "water beside"
-min = [0.04, 0.0]
-max = [0.1, 0.04]
-spacing = 0.005
-horizon = { factor = 3.0 }
-initial = 60.0
-[[region]]
-name = "water above"
-min = [0.0, 0.04]
-spacing = 0.005
-horizon = { factor = 3.0 }
-initial = 60.0
-"#,
-        r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [0.1]
-[[region]]
-name = "ice"
-max = [0.03]
-spacing = 0.002
-horizon = { factor = 3.0 }
-initial = -5.0
-[[region]]
-name = "water"
-min = [0.03]
-spacing = 0.002
-horizon = { factor = 3.0 }
-initial = 60.0
-"#,
+        CaseToml::new(2)
+            .key("symmetry = \"axisymmetric\"")
+            .domain("[0.0, 0.0]", "[0.1, 0.1]")
+            .region("ice", "spacing = 0.005", 3.0)
+            .region_key("max = [0.04, 0.04]")
+            .region_key("initial = -5.0")
+            .region("water beside", "spacing = 0.005", 3.0)
+            .region_key("min = [0.04, 0.0]")
+            .region_key("max = [0.1, 0.04]")
+            .region_key("initial = 60.0")
+            .region("water above", "spacing = 0.005", 3.0)
+            .region_key("min = [0.0, 0.04]")
+            .region_key("initial = 60.0"),
+        CaseToml::new(1)
+            .key("symmetry = \"spherical\"")
+            .domain("[0.0]", "[0.1]")
+            .region("ice", "spacing = 0.002", 3.0)
+            .region_key("max = [0.03]")
+            .region_key("initial = -5.0")
+            .region("water", "spacing = 0.002", 3.0)
+            .region_key("min = [0.03]")
+            .region_key("initial = 60.0"),
     ];
     for body in bodies {
-        let text = format!("{body}{water}[time]\nend = 100.0\n");
-        let case = Case::parse(&text, Path::new("ice.toml")).unwrap();
+        let case = body
+            .material("water", 0.6, 1000.0, 4182.0)
+            .section(
+                "[material.water.phase_change]\ntemperature = 0.0\nlatent_heat = 333e3\n\
+                 frozen_conductivity = 2.14\nfrozen_specific_heat = 2060.0",
+            )
+            .end(100.0)
+            .case("ice.toml");
         let model = Model::build(&case.spec).unwrap();
         let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
         let mut theta = model.theta0.clone();
@@ -218,47 +155,27 @@ initial = 60.0
     }
 }
 
-/// Planar freezing: water at +5 °C, the face x = 0 held at −10 °C by a mirrored layer. The
-/// front (where half of a node's latent heat is gone) follows Neumann's X(t) = 2λ√(α_f t)
-/// within two node spacings at every hour of two days (the issue's criterion). Δ = 5 mm,
-/// δ = 3Δ, constant kernel (seed 001); the far face (0.6 m, ~4 liquid diffusion lengths away)
-/// is held at +5 °C.
+/// Planar freezing: water at +5 °C, the face x = 0 held at −10 °C by a mirrored layer. The front
+/// (where half of a node's latent heat is gone) follows Neumann's X(t) = 2λ√(α_f t) within two node
+/// spacings at every hour of two days (the issue's criterion). Δ = 5 mm, δ = 3Δ, constant kernel
+/// (as in the axisymmetric phase-change paper); the far face (0.6 m, ~4 liquid diffusion lengths
+/// away) is held at +5 °C.
 #[test]
 fn planar_freezing_follows_the_neumann_front() {
-    let text = r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [0.6]
-[[region]]
-name = "body"
-spacing = 0.005
-horizon = { factor = 3.0 }
-[kernel]
-calibration = "lattice"
-[material.water]
-conductivity = 0.6
-density = 1000.0
-specific_heat = 4182.0
-[material.water.phase_change]
-temperature = 273.15
-latent_heat = 333e3
-frozen_conductivity = 2.14
-frozen_specific_heat = 2060.0
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = 263.15
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 278.15
-[initial]
-value = 278.15
-[time]
-end = 172800.0
-"#;
-    let case = Case::parse(text, Path::new("freezing.toml")).unwrap();
+    let case = CaseToml::new(1)
+        .domain("[0.0]", "[0.6]")
+        .region("body", "spacing = 0.005", 3.0)
+        .section("[kernel]\ncalibration = \"lattice\"")
+        .material("water", 0.6, 1000.0, 4182.0)
+        .section(
+            "[material.water.phase_change]\ntemperature = 273.15\nlatent_heat = 333e3\n\
+             frozen_conductivity = 2.14\nfrozen_specific_heat = 2060.0\n\
+             [boundary.x_min]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 263.15\n\
+             [boundary.x_max]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 278.15",
+        )
+        .initial_value(278.15)
+        .end(172800.0)
+        .case("freezing.toml");
     let model = Model::build(&case.spec).unwrap();
     let neumann = Reference::NeumannFreezing {
         x0: 0.0,
@@ -312,7 +229,8 @@ end = 172800.0
     assert!(worst <= 2.0 * spacing, "{worst}");
 }
 
-/// Water's T(H) and λ(H) of seed 001 eqs 1–3, written out again for the reference below.
+/// Water's T(H) and λ(H) of the axisymmetric phase-change paper, eqs 1–3, written out again for the
+/// reference below.
 fn water_state(h: f64) -> (f64, f64) {
     let (cf, cm, tf, l) = (2060.0e3, 4182.0e3, 273.15, 333e6);
     if h < cf * tf {
@@ -324,10 +242,10 @@ fn water_state(h: f64) -> (f64, f64) {
     }
 }
 
-/// An independent classical reference for seed 001 §3.3: a radial finite-volume enthalpy
-/// solve (cells of width `dr` on [r0, r1], harmonic face conductivities, the extracted flux
-/// `q` through the inner face, the outer face held at `outer` half a cell away), forward
-/// Euler at half its stability limit. Returns the temperatures at each of `times`.
+/// An independent classical reference for the axisymmetric phase-change paper §3.3: a radial
+/// finite-volume enthalpy solve (cells of width `dr` on [r0, r1], harmonic face conductivities, the
+/// extracted flux `q` through the inner face, the outer face held at `outer` half a cell away),
+/// forward Euler at half its stability limit. Returns the temperatures at each of `times`.
 fn radial_freezing(r0: f64, r1: f64, dr: f64, q: f64, outer: f64, times: &[f64]) -> Vec<Vec<f64>> {
     use std::f64::consts::PI;
     let n = ((r1 - r0) / dr).round() as usize;
@@ -368,10 +286,10 @@ fn radial_freezing(r0: f64, r1: f64, dr: f64, q: f64, outer: f64, times: &[f64])
     out
 }
 
-/// Seed 001 §3.3, freezing around a pipe (the bundled case, 1D axisymmetric): against the
-/// radial finite-volume enthalpy reference with 2 mm cells at 1, 2 and 3 days. Measures:
-/// ε of seed 001 eq 27 ≤ 0.5% (the issue's criterion for the symmetric cases) and the ice
-/// front (T = T_f crossing) within two node spacings.
+/// The axisymmetric phase-change paper §3.3, freezing around a pipe (the bundled case, 1D
+/// axisymmetric): against the radial finite-volume enthalpy reference with 2 mm cells at 1, 2 and 3
+/// days. Measures: ε of its eq 27 ≤ 0.5% (the issue's criterion for the symmetric cases) and the
+/// ice front (T = T_f crossing) within two node spacings.
 #[test]
 fn pipe_freezing_matches_a_radial_finite_volume_reference() {
     let case = Case::load(Path::new("cases/pipe_freezing.toml")).unwrap();

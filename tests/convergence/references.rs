@@ -1,49 +1,29 @@
 //! References exported by other codes: CSV tables read, checked and interpolated at the nodes.
 
+use crate::common::case::CaseToml;
 use peritherm::case::{Case, ReferenceSource};
 use peritherm::model::Model;
 use peritherm::report::classical_at;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// A 2D square held at 0 °C from 40 °C (seed 003 Example 1, coarse), its reference given by
-/// `reference` (TOML lines of the `[reference]` table).
+/// A 2D square held at 0 °C from 40 °C (Bobaru & Duangpanya 2012 Example 1, coarse), its reference
+/// given by `reference` (TOML lines of the `[reference]` table).
 fn square(reference: &str) -> String {
-    format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[region]]
-name = "square"
-cells = [32, 32]
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.14
-density = 1.0
-specific_heat = 1.0
-[boundary.x_min]
-type = "temperature"
-value = 0.0
-[boundary.x_max]
-type = "temperature"
-value = 0.0
-[boundary.y_min]
-type = "temperature"
-value = 0.0
-[boundary.y_max]
-type = "temperature"
-value = 0.0
-[initial]
-value = 40.0
-[time]
-end = 0.1
-outputs = [0.05, 0.1]
-[reference]
-{reference}
-"#
-    )
+    let mut c = CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 1.0]")
+        .region("square", "cells = [32, 32]", 3.0)
+        .material("m", 1.14, 1.0, 1.0);
+    for face in ["x_min", "x_max", "y_min", "y_max"] {
+        c = c.section(&format!(
+            "[boundary.{face}]\ntype = \"temperature\"\nvalue = 0.0"
+        ));
+    }
+    c.section(&format!("[reference]\n{reference}"))
+        .initial_value(40.0)
+        .end(0.1)
+        .time_key("outputs = [0.05, 0.1]")
+        .text()
 }
 
 const SERIES: &str = r#"[reference.solution]

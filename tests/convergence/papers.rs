@@ -27,8 +27,8 @@ fn run(case: &Case) -> Vec<Comparison> {
     s.reference
 }
 
-/// Seed 000 Example 3 at δ = 3L/200 (m = 4, 267 nodes) must already beat the paper's
-/// eq 45 = 3.43e-5, which the paper reached with a 4× smaller horizon (δ = 3L/800).
+/// Bobaru & Duangpanya 2010 Example 3 at δ = 3L/200 (m = 4, 267 nodes) must already beat the
+/// paper's eq 45 = 3.43e-5, which the paper reached with a 4× smaller horizon (δ = 3L/800).
 #[test]
 fn bar_flux_beats_seed000_eq45() {
     let case = case_with(
@@ -47,10 +47,10 @@ fn bar_flux_beats_seed000_eq45() {
     );
 }
 
-/// Seed 000 Examples 1 and 2: δ-convergence of eq 13 at t = 8 s between δ = 3L/100 and
-/// 3L/200 at m = 4; the paper reports rates ≈ 1.0 and 1.5 for eq 45 (a squared measure, so
-/// ≥ 0.5 for our unsquared one); we require a rate ≥ 0.5, and eq 13 at δ = 3L/200 below
-/// the levels measured when this test was written (0.0316 and 0.0101) plus 10 %.
+/// Bobaru & Duangpanya 2010 Examples 1 and 2: δ-convergence of eq 13 at t = 8 s between δ = 3L/100
+/// and 3L/200 at m = 4; the paper reports rates ≈ 1.0 and 1.5 for eq 45 (a squared measure, so ≥
+/// 0.5 for our unsquared one); we require a rate ≥ 0.5, and eq 13 at δ = 3L/200 below the levels
+/// measured when this test was written (0.0316 and 0.0101) plus 10 %.
 #[test]
 fn bars_converge_in_delta() {
     for (name, level) in [
@@ -75,8 +75,8 @@ fn bars_converge_in_delta() {
     }
 }
 
-/// Seed 003 Example 2 at δ = 13L/120 (61 × 61 nodes, m = 6.5): eq 13 along y = 0.5 at or
-/// below Table 1's first column (0.15741, 0.11342, 0.07517) at every time.
+/// Bobaru & Duangpanya 2012 Example 2 at δ = 13L/120 (61 × 61 nodes, m = 6.5): eq 13 along y = 0.5
+/// at or below Table 1's first column (0.15741, 0.11342, 0.07517) at every time.
 #[test]
 fn square_one_hot_edge_meets_table1() {
     let case = case_with(
@@ -96,9 +96,9 @@ fn square_one_hot_edge_meets_table1() {
     }
 }
 
-/// Seed 003 Example 1 at δ = 13L/120 with Δ = L/64 (m = 6.93): eq 13 along y = 0.5 small,
-/// and the solution decays like the classical one (tolerance: seed 003 Fig. 12 shows eq 13
-/// of a few 1e-2 at this horizon).
+/// Bobaru & Duangpanya 2012 Example 1 at δ = 13L/120 with Δ = L/64 (m = 6.93): eq 13 along y = 0.5
+/// small, and the solution decays like the classical one (tolerance: Bobaru & Duangpanya 2012 Fig.
+/// 12 shows eq 13 of a few 1e-2 at this horizon).
 #[test]
 fn square_dirichlet_follows_the_series() {
     let case = case_with(
@@ -115,9 +115,10 @@ fn square_dirichlet_follows_the_series() {
     }
 }
 
-/// Seed 004 §4.1, the dual-horizon plates at a 2.5× coarser spacing (Δ1 = 2.5e-4 m), as
-/// bundled (lattice calibration and linear-consistency correction): every node within 1 % of
-/// the 10 °C span of the classical solution at 5 ms, the paper's figure to meet.
+/// Wang, Oterkus & Oterkus (dual-horizon paper) §4.1, the dual-horizon plates at a 2.5× coarser
+/// spacing (Δ1 = 2.5e-4 m), as bundled (lattice calibration and linear-consistency correction):
+/// every node within 1 % of the 10 °C span of the classical solution at 5 ms, the paper's figure to
+/// meet.
 #[test]
 fn dual_horizon_plates_within_one_percent() {
     for (name, d1, d2, dt) in [
@@ -155,8 +156,8 @@ fn dual_horizon_plates_within_one_percent() {
     }
 }
 
-/// Seed 004 §4.2 thermal shock at Δ = 0.1 m (k = 0.5, m = 0.5 at Δ1 = 0.1, Δ2 = 0.2):
-/// against the Duhamel series at 3 and 6 s within 2 % of the peak boundary value 0.92 °C.
+/// Wang, Oterkus & Oterkus §4.2 thermal shock at Δ = 0.1 m (k = 0.5, m = 0.5 at Δ1 = 0.1, Δ2 =
+/// 0.2): against the Duhamel series at 3 and 6 s within 2 % of the peak boundary value 0.92 °C.
 #[test]
 fn thermal_shock_follows_duhamel() {
     let case = case_with(
@@ -178,7 +179,7 @@ fn thermal_shock_follows_duhamel() {
     }
 }
 
-/// Comparison measures are those of formulation §9 (checked on a hand-made field).
+/// Comparison measures are those of theory §9 (checked on a hand-made field).
 #[test]
 fn measures_follow_the_formulas() {
     let case = case_with(

@@ -144,7 +144,7 @@ fn sweep_varies_the_mesh_file() {
         .iter()
         .map(|l| format!("../meshes/conv_rect_quad_L{l}.msh"))
         .collect();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_peritherm"))
+    let o = crate::common::cli::command()
         .arg("sweep")
         .arg(root.join("cases/conv_rect_quad.toml"))
         .arg("--vary")

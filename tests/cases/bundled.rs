@@ -39,7 +39,8 @@ fn every_case_builds_and_starts() {
             case.dt.unwrap_or(0.9 * bound)
         };
         case.outputs = vec![3.0 * dt];
-        // a FEM reference would be solved in full first: tests/references.rs covers that path
+        // a FEM reference would be solved in full first: tests/convergence/references.rs covers
+        // that path
         if case
             .reference
             .as_ref()

@@ -1,7 +1,8 @@
-//! Implicit schemes and the steady solve (formulation §4): temporal orders against an RK4
+//! Implicit schemes and the steady solve (theory §4): temporal orders against an RK4
 //! reference, steady state against the explicit run and exact/classical solutions, energy
 //! conservation, refusals, serial == parallel.
 
+use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
@@ -11,73 +12,34 @@ use std::path::Path;
 /// A 1D bar, 100 nodes, δ = 3Δ, the left end following θ = 5t·e^(−2t) through a mirrored layer,
 /// the right end insulated (mirrored layer): a smooth transient.
 fn bar(left: &str, right: &str, initial: &str) -> Case {
-    let text = format!(
-        r#"
-dimension = 1
-[domain]
-min = [0.0]
-max = [1.0]
-[[region]]
-name = "bar"
-spacing = 0.01
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 1.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.x_min]
-{left}
-[boundary.x_max]
-{right}
-[initial]
-value = "{initial}"
-[time]
-end = 1.0
-integrator = "rk4"
-"#
-    );
-    Case::parse(&text, Path::new("bar.toml")).unwrap()
+    CaseToml::new(1)
+        .domain("[0.0]", "[1.0]")
+        .region("bar", "spacing = 0.01", 3.0)
+        .material("m", 1.0, 1.0, 1.0)
+        .section("[kernel]\np = 2\ncalibration = \"lattice\"")
+        .section(&format!("[boundary.x_min]\n{left}"))
+        .section(&format!("[boundary.x_max]\n{right}"))
+        .initial(initial)
+        .time_key("integrator = \"rk4\"")
+        .case("bar.toml")
 }
 
 /// A 2D plate 1 × 0.5 of two regions with the same lattice (Δ = 0.025, δ = 3Δ), the faces
 /// given by `faces`, a non-uniform initial field.
 fn plate(faces: &str) -> Case {
-    let text = format!(
-        r#"
-dimension = 2
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-thickness = 0.1
-[[region]]
-name = "fine"
-max = [0.5, 0.5]
-spacing = 0.025
-horizon = {{ factor = 3 }}
-[[region]]
-name = "coarse"
-min = [0.5, 0.0]
-spacing = 0.025
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 2.0
-density = 300.0
-specific_heat = 0.5
-[kernel]
-p = 1
-calibration = "lattice"
-{faces}
-[initial]
-value = "sin(7*x) + 3*cos(5*y) + x*y"
-[time]
-end = 1.0
-integrator = "euler"
-"#
-    );
-    Case::parse(&text, Path::new("plate.toml")).unwrap()
+    CaseToml::new(2)
+        .domain("[0.0, 0.0]", "[1.0, 0.5]")
+        .domain_key("thickness = 0.1")
+        .region("fine", "spacing = 0.025", 3.0)
+        .region_key("max = [0.5, 0.5]")
+        .region("coarse", "spacing = 0.025", 3.0)
+        .region_key("min = [0.5, 0.0]")
+        .material("m", 2.0, 300.0, 0.5)
+        .section("[kernel]\np = 1\ncalibration = \"lattice\"")
+        .section(faces)
+        .initial("sin(7*x) + 3*cos(5*y) + x*y")
+        .time_key("integrator = \"euler\"")
+        .case("plate.toml")
 }
 
 const INSULATED: &str = r#"
@@ -156,9 +118,9 @@ fn temporal_orders_against_rk4() {
     }
 }
 
-/// Nodal Dirichlet (driven nodes) and seed 000's flux relation (slaved nodes) are eliminated
-/// correctly: CN and BDF2 at h = 0.0025 s agree with RK4 to 1e-4 °C (their time error at this
-/// step is ~1e-6 °C on the mirrored bar above; a wrong elimination errs by O(1) °C).
+/// Nodal Dirichlet (driven nodes) and Bobaru & Duangpanya 2010's flux relation (slaved nodes) are
+/// eliminated correctly: CN and BDF2 at h = 0.0025 s agree with RK4 to 1e-4 °C (their time error at
+/// this step is ~1e-6 °C on the mirrored bar above; a wrong elimination errs by O(1) °C).
 #[test]
 fn nodal_and_relation_constraints_match_rk4() {
     let case = bar(

@@ -1,19 +1,20 @@
-//! Axisymmetric and spherical peridynamics (seed 001 §2.2–2.4, formulation §7): steady radial
-//! states against their exact solutions (second-order δ-convergence), the cooling sphere
-//! against its series, exact energy conservation of an insulated axisymmetric body, and the
-//! radial heat flux of seed 001 eq 25 against −k dθ/dr.
+//! Axisymmetric and spherical peridynamics (the axisymmetric phase-change paper,
+//! doi:10.1007/s42102-022-00092-3, §2.2–2.4; theory §7): steady radial states against their exact
+//! solutions (second-order δ-convergence), the cooling sphere against its series, exact energy
+//! conservation of an insulated axisymmetric body, and the radial heat flux of the paper's eq 25
+//! against −k dθ/dr.
 //!
-//! `cargo test --release --test symmetry -- --nocapture` prints the measured figures.
+//! `cargo test --release --test cases symmetry:: -- --nocapture` prints the measured figures.
 
+use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
 
-fn case(text: &str) -> Case {
-    Case::parse(text, Path::new("symmetry.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
+/// The kernel of every test here: constant p = 2 profile, lattice calibration.
+const KERNEL: &str = "[kernel]\np = 2\ncalibration = \"lattice\"";
 
 /// The steady state of `c` (one SPD solve with the boundary values at t = 1).
 fn steady(c: &Case) -> (Model, Vec<f64>) {
@@ -48,40 +49,20 @@ fn wall(symmetry: &str, dim: usize, dx: f64) -> Case {
             "[boundary.y_min]\ntype = \"insulated\"\n[boundary.y_max]\ntype = \"insulated\"\n",
         )
     };
-    case(&format!(
-        r#"
-dimension = {dim}
-symmetry = "{symmetry}"
-[domain]
-min = {min}
-max = {max}
-[[region]]
-name = "wall"
-spacing = {dx}
-horizon = {{ factor = 3 }}
-[material.m]
-conductivity = 4.0
-density = 1.0
-specific_heat = 1.0
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.x_min]
-type = "temperature"
-method = "mirror"
-value = 100.0
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 0.0
-{z}
-[initial]
-value = 0.0
-[time]
-end = 1.0
-integrator = "steady"
-"#
-    ))
+    CaseToml::new(dim)
+        .key(&format!("symmetry = \"{symmetry}\""))
+        .domain(min, max)
+        .region("wall", &format!("spacing = {dx}"), 3.0)
+        .material("m", 4.0, 1.0, 1.0)
+        .section(KERNEL)
+        .section(
+            "[boundary.x_min]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 100.0\n\
+             [boundary.x_max]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 0.0",
+        )
+        .section(z)
+        .initial_value(0.0)
+        .time_key("integrator = \"steady\"")
+        .case("symmetry.toml")
 }
 
 /// An exact radial profile θ(r), °C.
@@ -94,11 +75,11 @@ fn max_error(model: &Model, theta: &[f64], exact: &dyn Fn(f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Steady PD states of the wall at Δ = 1/40, 1/80, 1/160 of its thickness (m = 3) against
-/// the exact radial solutions: the largest nodal error falls as δ², observed rate ≥ 1.8
-/// between every pair (measured 1.98–2.00), and is below 0.05 °C of the 100 °C span at the
-/// finest spacing (measured 2.4e-3, 2.5e-3 and 6.5e-3 °C).
-/// - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a)) (seed 001 eq 10's Ω);
+/// Steady PD states of the wall at Δ = 1/40, 1/80, 1/160 of its thickness (m = 3) against the exact
+/// radial solutions: the largest nodal error falls as δ², observed rate ≥ 1.8 between every pair
+/// (measured 1.98–2.00), and is below 0.05 °C of the 100 °C span at the finest spacing (measured
+/// 2.4e-3, 2.5e-3 and 6.5e-3 °C). - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a)) (the
+/// axisymmetric phase-change paper, eq 10's Ω);
 /// - spherical shell: θ = A + B/r, B = 100 a b/(b − a), A = −B/b (eq 21's Ω_sp).
 ///
 /// A planar operator (Ω = 1) would give the straight line, up to 8.6 °C (at r = 0.72 m) away
@@ -135,11 +116,11 @@ fn steady_radial_states_converge_at_second_order() {
     }
 }
 
-/// The radial PD heat flux (formulation §8 with the true ring volume, i.e. seed 001 eq 25:
-/// q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric wall
-/// (1D, and 2D with its axial component) against Fourier's −k dθ/dr = 100 k/(r ln(b/a)),
-/// at Δ = (b − a)/80 and (b − a)/160:
-/// - nodes beyond the reach of the mirrored layers (δ + Δ/2 from both faces): for θ linear in ln r the first-order terms of Ω and of
+/// The radial PD heat flux (theory §8 with the true ring volume, i.e. the axisymmetric phase-change
+/// paper, eq 25: q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric
+/// wall (1D, and 2D with its axial component) against Fourier's −k dθ/dr = 100 k/(r ln(b/a)), at Δ
+/// = (b − a)/80 and (b − a)/160: - nodes beyond the reach of the mirrored layers (δ + Δ/2 from both
+/// faces): for θ linear in ln r the first-order terms of Ω and of
 ///   the curvature cancel in the half-horizon sum, so the relative difference is O(δ²):
 ///   below 1e-4 at the finer spacing (measured 2.9e-5; 1.1e-4 at the coarser) and falling
 ///   at least 3.5× when Δ halves (measured 4.0×);
@@ -190,55 +171,34 @@ fn radial_flux_matches_fourier() {
     }
 }
 
-/// Seed 001 §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k = 400, ρ = 8920,
-/// c = 385, θ0 = 1000 K, surface 300 K by mirrored layers, centre free) with Δ = R/20, R/40,
-/// R/80 (δ = 3Δ), forward Euler at 0.9 of the stable step, against the series
-/// `sphere_fixed_surface` at t = 2, 5 and 10 s: ε (seed 001 eq 27) falls as δ², observed
-/// rate ≥ 1.8 between every pair (measured 1.87–2.01), and is below 0.5 % (the paper's bar)
-/// on every grid (largest: 4.5e-3 at R/20, 10 s). The centre takes no layer (no bond
-/// crosses r = 0), as in the paper.
+/// The axisymmetric phase-change paper §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k =
+/// 400, ρ = 8920, c = 385, θ0 = 1000 K, surface 300 K by mirrored layers, centre free) with Δ =
+/// R/20, R/40, R/80 (δ = 3Δ), forward Euler at 0.9 of the stable step, against the series
+/// `sphere_fixed_surface` at t = 2, 5 and 10 s: ε (its eq 27) falls as δ², observed rate ≥ 1.8
+/// between every pair (measured 1.87–2.01), and is below 0.5 % (the paper's bar) on every grid
+/// (largest: 4.5e-3 at R/20, 10 s). The centre takes no layer (no bond crosses r = 0), as in the
+/// paper.
 #[test]
 fn sphere_cools_as_the_series() {
     let alpha = 400.0 / (8920.0 * 385.0);
     let times = [2.0, 5.0, 10.0];
     let mut eps: Vec<Vec<f64>> = Vec::new();
     for n in [20.0, 40.0, 80.0] {
-        let c = case(&format!(
-            r#"
-dimension = 1
-symmetry = "spherical"
-[domain]
-min = [0.0]
-max = [0.1]
-[[region]]
-name = "sphere"
-spacing = {}
-horizon = {{ factor = 3 }}
-[material.copper]
-conductivity = 400.0
-density = 8920.0
-specific_heat = 385.0
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.x_max]
-type = "temperature"
-method = "mirror"
-value = 300.0
-[initial]
-value = 1000.0
-[time]
-end = 10.0
-integrator = "euler"
-[reference.solution]
-kind = "sphere_fixed_surface"
-radius = 0.1
-diffusivity = {alpha:e}
-surface = 300.0
-initial = 1000.0
-"#,
-            0.1 / n
-        ));
+        let c = CaseToml::new(1)
+            .key("symmetry = \"spherical\"")
+            .domain("[0.0]", "[0.1]")
+            .region("sphere", &format!("spacing = {}", 0.1 / n), 3.0)
+            .material("copper", 400.0, 8920.0, 385.0)
+            .section(KERNEL)
+            .section("[boundary.x_max]\ntype = \"temperature\"\nmethod = \"mirror\"\nvalue = 300.0")
+            .section(&format!(
+                "[reference.solution]\nkind = \"sphere_fixed_surface\"\nradius = 0.1\n\
+                 diffusivity = {alpha:e}\nsurface = 300.0\ninitial = 1000.0"
+            ))
+            .initial_value(1000.0)
+            .end(10.0)
+            .time_key("integrator = \"euler\"")
+            .case("symmetry.toml");
         let model = Model::build(&c.spec).unwrap();
         let dt = 0.9 * choose_dt(&model, Integrator::Euler, None).unwrap() / 0.95;
         let series = match &c.reference.as_ref().unwrap().source {
@@ -288,37 +248,19 @@ initial = 1000.0
 /// its ghost sits at another radius than its image, so K_ig differs from the mirrored pair.)
 #[test]
 fn insulated_axisymmetric_body_conserves_energy() {
-    let c = case(
-        r#"
-dimension = 2
-symmetry = "axisymmetric"
-[domain]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-[[region]]
-name = "body"
-spacing = 0.025
-horizon = { factor = 3 }
-[material.m]
-conductivity = 2.0
-density = 300.0
-specific_heat = 0.5
-[kernel]
-p = 2
-calibration = "lattice"
-[boundary.y_min]
-type = "insulated"
-method = "mirror"
-[boundary.y_max]
-type = "insulated"
-method = "mirror"
-[initial]
-value = "100*sin(7*x)*cos(5*y) + 20*x*y + 50"
-[time]
-end = 1.0
-integrator = "euler"
-"#,
-    );
+    let c = CaseToml::new(2)
+        .key("symmetry = \"axisymmetric\"")
+        .domain("[0.0, 0.0]", "[1.0, 0.5]")
+        .region("body", "spacing = 0.025", 3.0)
+        .material("m", 2.0, 300.0, 0.5)
+        .section(KERNEL)
+        .section(
+            "[boundary.y_min]\ntype = \"insulated\"\nmethod = \"mirror\"\n\
+             [boundary.y_max]\ntype = \"insulated\"\nmethod = \"mirror\"",
+        )
+        .initial("100*sin(7*x)*cos(5*y) + 20*x*y + 50")
+        .time_key("integrator = \"euler\"")
+        .case("symmetry.toml");
     let model = Model::build(&c.spec).unwrap();
     for integ in [Integrator::Euler, Integrator::Rk4] {
         let dt = choose_dt(&model, integ, None).unwrap();

@@ -1,10 +1,8 @@
 //! Hostile input and interrupted runs (issue 15), as a user meets them on the command line:
 //! every example ends with one line naming the file and the key, a non-zero exit, within
-//! 5 s and under 1 GiB of address space ([`common::hostile`]), and `--out` never mixes runs.
+//! 5 s and under 1 GiB of address space ([`crate::common::hostile`]), and `--out` never mixes runs.
 
-mod common;
-
-use common::hostile::{assert_refused, entries, peritherm, wait_for, write_case, PLATE};
+use crate::common::hostile::{assert_refused, entries, peritherm, wait_for, write_case, PLATE};
 use std::path::Path;
 use std::time::Duration;
 
@@ -152,7 +150,7 @@ fn run_plate(
     outputs: &str,
     extra: &str,
     out: &Path,
-) -> common::hostile::Outcome {
+) -> crate::common::hostile::Outcome {
     let last = outputs.rsplit(',').next().unwrap().trim();
     let text = PLATE.replace("end = 2.0", &format!("end = {last}\noutputs = [{outputs}]")) + extra;
     let case = write_case(dir, name, &text);
@@ -236,7 +234,7 @@ fn an_interrupted_run_says_so_and_leaves_no_partial_file() {
         "end = 1e4\ndt = 1e-3\noutputs = [0.01, 0.02, 1e4]",
     );
     let case = write_case(dir.path(), "long.toml", &text);
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_peritherm"))
+    let mut child = crate::common::cli::command()
         .args([
             "run",
             case.to_str().unwrap(),
@@ -408,7 +406,7 @@ fn duplicated_elements_and_empty_regions_are_refused() {
 }
 
 /// `check` accepts the bundled cases whose set-up is quick (the adaptive crack plate among
-/// them: it has time.tolerance and no time.dt); `tests/cases.rs` takes every bundled case
+/// them: it has time.tolerance and no time.dt); `tests/cases/bundled.rs` takes every bundled case
 /// through the same validation path ([`peritherm::prepare`]) before it runs a few steps.
 #[test]
 fn check_accepts_the_quick_bundled_cases() {
