@@ -921,7 +921,7 @@ mod tests {
     /// The midpoint values printed by Bobaru & Duangpanya 2010 at t = 8 s (±0.005 °C: the paper
     /// prints 2 decimals).
     #[test]
-    fn seed000_midpoints() {
+    fn bobaru_duangpanya_2010_midpoints() {
         let ex1 = Reference::BarFixedEnds {
             x0: 0.0,
             length: 10.0,

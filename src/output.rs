@@ -3,7 +3,9 @@
 //! Contract: for the k-th output time (k from 1), `field_<k>.csv` with the columns
 //! `x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz`, one row per body
 //! node, and the same fields as a VTK unstructured grid `field_<k>.vtu`; and `run.json`.
-//! A case with a `[history]` also writes `history.csv` ([`crate::history`]).
+//! A case with a `[history]` also writes `history.csv` ([`crate::history`]); every run
+//! (also one that fails or is interrupted) writes `case.toml`, the text of its case
+//! ([`crate::provenance`]).
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};

@@ -69,6 +69,8 @@ fn execute(
         mut implicit,
     } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
+    // first, so that a run that fails or is interrupted also says which case it was
+    let origin = crate::provenance::write_copy(out, case)?;
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let mut energy = Vec::new();
@@ -206,7 +208,6 @@ fn execute(
         Some(r) => Some(r.write(out)?),
         None => None,
     };
-    let origin = crate::provenance::write_copy(out, case)?;
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),

@@ -343,6 +343,7 @@ fn solve(
 ) -> Result<RunSummary> {
     let mut stepper = Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme);
     let setup_seconds = t_setup.elapsed().as_secs_f64();
+    let origin = crate::provenance::write_copy(out, case)?;
     let total: u64 = match opts.scheme {
         Scheme::Steady => case.outputs.len() as u64,
         _ => {
@@ -422,7 +423,6 @@ fn solve(
         )?;
         fields.push(format!("field_{}.csv", k + 1));
     }
-    let origin = crate::provenance::write_copy(out, case)?;
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),

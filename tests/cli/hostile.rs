@@ -182,6 +182,7 @@ fn output_directories_are_transactional() {
     let o = run_plate(dir.path(), "two.toml", "1, 2", "", &out);
     assert_eq!(o.code, Some(0), "{}", o.stderr);
     let want = [
+        "case.toml",
         "field_1.csv",
         "field_1.vtu",
         "field_2.csv",

@@ -30,7 +30,7 @@ fn run(case: &Case) -> Vec<Comparison> {
 /// Bobaru & Duangpanya 2010 Example 3 at δ = 3L/200 (m = 4, 267 nodes) must already beat the
 /// paper's eq 45 = 3.43e-5, which the paper reached with a 4× smaller horizon (δ = 3L/800).
 #[test]
-fn bar_flux_beats_seed000_eq45() {
+fn bar_flux_beats_bobaru_duangpanya_2010_eq45() {
     let case = case_with(
         "bar_flux.toml",
         &[
