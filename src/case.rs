@@ -555,6 +555,11 @@ impl Case {
     }
 }
 
+/// `file` (as a case file writes it) resolved against the folder of the case file `path`.
+fn beside(path: &Path, file: &Path) -> PathBuf {
+    path.parent().unwrap_or(Path::new(".")).join(file)
+}
+
 fn expr(v: &ValueSpec, path: &Path, key: &str) -> Result<Expr> {
     match v {
         ValueSpec::Number(x) if x.is_finite() => Ok(Expr::constant(*x)),
@@ -631,11 +636,11 @@ fn reference(
                 dt: f.dt,
                 mesh: f
                     .mesh
-                    .map(|m| path.parent().unwrap_or(Path::new(".")).join(m)),
+                    .map(|m| beside(path, &m)),
             })
         }
         (None, Some(file), None) => {
-            let file = path.parent().unwrap_or(Path::new(".")).join(file);
+            let file = beside(path, &file);
             let table = ReferenceTable::read(&file, dim)?;
             table
                 .check_times(outputs)
@@ -992,7 +997,7 @@ impl CaseFile {
         rules: &[(HorizonRule, u16)],
     ) -> Result<MeshGeometry> {
         let dim = self.dimension;
-        let file = path.parent().unwrap_or(Path::new(".")).join(&m.file);
+        let file = beside(path, &m.file);
         let mesh =
             crate::gmsh::read(&file).map_err(|e| case_err(path, "mesh.file", e.to_string()))?;
         if mesh.dim() != dim {
@@ -1675,7 +1680,6 @@ impl CaseFile {
 
     /// The files besides itself that the case at `path` reads, resolved against its folder.
     fn inputs(&self, path: &Path) -> Vec<PathBuf> {
-        let base = path.parent().unwrap_or(Path::new("."));
         let reference = self.reference.as_ref();
         let table = reference.and_then(|r| r.file.as_ref());
         let fem_mesh = reference
@@ -1685,7 +1689,7 @@ impl CaseFile {
         [mesh, table, fem_mesh]
             .into_iter()
             .flatten()
-            .map(|f| base.join(f))
+            .map(|f| beside(path, f))
             .collect()
     }
 }

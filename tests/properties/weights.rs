@@ -197,21 +197,20 @@ fn hexahedra_left_out_nodes_are_reported_not_refused() {
     assert_eq!(met, c.corrected);
 }
 
-/// Every body group of `file` (under meshes/) as a region with δ = 3Δ, one material, every
-/// boundary facet free (no group named), the default kernel: the consistent weights are on.
+/// Every body group of `file` (under meshes/) as a region with δ = 3Δ, one material, no
+/// boundary named (so every boundary takes the default, an insulating mirrored layer), the
+/// default kernel: the consistent weights are on.
 fn default_model(file: &Path) -> Result<Model, String> {
     let mesh = peritherm::gmsh::read(file).map_err(|e| e.to_string())?;
     let dim = mesh.dim();
-    let mut text = format!("dimension = {dim}\n[mesh]\nfile = \"{}\"\n", file.display());
-    for g in mesh.groups.iter().filter(|g| g.dim == dim) {
-        text += &format!(
-            "[[region]]\nname = \"{}\"\nhorizon = {{ factor = 3 }}\n",
-            g.name
-        );
-    }
-    text += "[material.m]\nconductivity = 1.0\ndensity = 1.0\nspecific_heat = 1.0\n";
-    text += "[initial]\nvalue = 1.0\n[time]\nend = 1.0\n";
-    let case = peritherm::case::Case::parse(&text, Path::new("every_mesh.toml"))
+    let body = mesh.groups.iter().filter(|g| g.dim == dim);
+    let toml = body
+        .fold(CaseToml::new(dim), |t, g| t.region(&g.name, "", 3.0))
+        .mesh(&file.display().to_string())
+        .material("m", 1.0, 1.0, 1.0)
+        .initial_value(1.0)
+        .end(1.0);
+    let case = peritherm::case::Case::parse(&toml.text(), Path::new("every_mesh.toml"))
         .map_err(|e| e.to_string())?;
     Model::build(&case.spec).map_err(|e| e.to_string())
 }
@@ -255,7 +254,7 @@ fn assert_none_refused(files: &[PathBuf]) {
 }
 
 /// No mesh of meshes/ up to 80 kB (11 of 37, each below 2 000 nodes) is refused with the
-/// default settings and every facet free. The larger ones are built by the bundled cases and
+/// default settings (no boundary named). The larger ones are built by the bundled cases and
 /// the convergence tests, and all of them by the ignored test below.
 #[test]
 fn no_committed_mesh_is_refused() {
