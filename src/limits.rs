@@ -48,6 +48,17 @@ pub const IMPLICIT_BOND_FACTOR: f64 = 4.0;
 /// sparse Cholesky factor's fill, taken as ten times the entries).
 pub const FEM_BYTES_PER_ENTRY: f64 = 200.0;
 
+/// Largest number of stored entries of the consistent weights' Newton matrix solved with one
+/// sparse Cholesky factor (2D clouds; about 190 000 nodes at δ = 3Δ, ~16 GB at
+/// [`CORRECTION_BYTES_PER_ENTRY`]). Beyond it, and in 3D, preconditioned CG, which needs
+/// thousands of iterations per Newton step on large 2D meshes.
+pub const MAX_DIRECT_ENTRIES: f64 = 1.6e8;
+
+/// Bytes per stored entry of that Newton matrix at the correction's peak (the matrix, the
+/// factor's fill and the solver's scratch): 5.9 GB measured for 5.8·10⁷ entries
+/// (meshes/pipe_heating_fem.msh as one plane region, 70 524 nodes), rounded up.
+pub const CORRECTION_BYTES_PER_ENTRY: f64 = 100.0;
+
 /// Fraction of the machine's available memory a run may plan to use without `--max-memory`.
 pub const MEMORY_FRACTION: f64 = 0.8;
 

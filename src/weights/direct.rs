@@ -15,8 +15,9 @@ use rayon::prelude::*;
 
 /// Largest number of stored entries of H's lower triangle solved directly (beyond it, or in
 /// 3D where the fill of a horizon of ~100 neighbours grows too fast: CG with the two-level
-/// preconditioner). 2.4·10⁷ entries are ~48 000 nodes of a 2D cloud at δ = 3Δ (about 2 GB of factor).
-const MAX_ENTRIES: usize = 24_000_000;
+/// preconditioner, which on large 2D meshes needs thousands of iterations per Newton step).
+/// The set-up's memory estimate counts the factor ([`crate::budget::estimate`]).
+const MAX_ENTRIES: usize = crate::limits::MAX_DIRECT_ENTRIES as usize;
 
 /// The lower triangle of H in compressed columns, and its Cholesky factor.
 pub(super) struct Direct {

@@ -323,7 +323,12 @@ impl<'a> Problem<'a> {
         rows.into_par_iter().with_min_len(256).for_each(|(i, row)| {
             for (v, e) in row.iter_mut().zip(off[i]..off[i + 1]) {
                 let j = self.cols[e] as usize;
-                *v = self.k0[e] * self.exponent(lambda, i, j).exp();
+                // a held pair stays 0 (never 0·∞ where λ has run off at a node without a solution)
+                *v = if self.k0[e] == 0.0 {
+                    0.0
+                } else {
+                    self.k0[e] * self.exponent(lambda, i, j).exp()
+                };
             }
         });
     }
@@ -463,6 +468,9 @@ impl Precond<'_> {
     }
 }
 
+/// CG iterations preconditioned by an old factor of H beyond which it is factorised anew.
+const REFACTOR_AFTER: usize = 25;
+
 /// Solves H x = b by preconditioned CG to `rel` of |b|; returns the iterations.
 fn solve(
     p: &Problem,
@@ -472,7 +480,11 @@ fn solve(
     pre: &mut Precond,
     rel: Real,
 ) -> usize {
-    let cap = 20_000;
+    // a factor of H at earlier weights that needs more than this is refreshed by the caller
+    let cap = match pre {
+        Precond::Direct(_) => 2 * REFACTOR_AFTER,
+        Precond::TwoLevel(..) => 20_000,
+    };
     let precondition = |r: &[Mom], z: &mut Vec<Mom>, pre: &mut Precond| pre.apply(r, z);
     x.iter_mut().for_each(|v| *v = Mom::zeros());
     let norm_b = dot(b, b).sqrt();
@@ -549,7 +561,7 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
         if let Some(d) = direct.as_mut().filter(|_| newton > 0) {
             it = solve(p, vals, &rhs, &mut step, &mut Precond::Direct(d), forcing);
         }
-        if it > 25 {
+        if it > REFACTOR_AFTER {
             it = 0;
             let factored = direct.as_mut().is_some_and(|d| d.factorise(p, vals));
             if factored {
@@ -632,18 +644,8 @@ pub fn correct(
     let (vals, left_out) = loop {
         let active = p.rings(&seeds, hops, &full);
         let whole = active == full;
-        let mut local = p.restricted(&active, &full);
-        let mut tried = Consistency::default();
-        let (mut vals, left_out) = solve_selection(&mut local, order, &mut tried);
-        out.newton += tried.newton;
-        out.iterations += tried.iterations;
+        let (vals, left_out) = solve_piece(&p, &active, &full, order, &mut out);
         if whole || !left_out.contains(&true) {
-            // the pairs held fixed come back
-            for (v, (k0, l)) in vals.iter_mut().zip(p.k0.iter().zip(&local.k0)) {
-                if *l == 0.0 {
-                    *v = *k0;
-                }
-            }
             break (vals, left_out);
         }
         hops *= 2;
@@ -655,6 +657,26 @@ pub fn correct(
     let sel = p.sel;
     store(k, vals);
     (out, sel)
+}
+
+/// The weights with the pairs among `active` solved for in one piece (the others keep
+/// theirs), and the nodes left out.
+fn solve_piece(
+    p: &Problem,
+    active: &[bool],
+    full: &[bool],
+    order: Order,
+    out: &mut Consistency,
+) -> (Vec<Real>, Vec<bool>) {
+    let mut local = p.restricted(active, full);
+    let (mut vals, left_out) = solve_selection(&mut local, order, out);
+    // the pairs held fixed come back
+    for (v, (k0, l)) in vals.iter_mut().zip(p.k0.iter().zip(&local.k0)) {
+        if *l == 0.0 {
+            *v = *k0;
+        }
+    }
+    (vals, left_out)
 }
 
 /// The corrected weights for the nodes `p.sel` (the additive form first for the linear order,
