@@ -14,6 +14,7 @@
 use crate::common::heat_fd::{disc_fd, plate_held_left_fd, slab_source_fd, BoxFd};
 use peritherm::analytic::{AxisEnds, Reference};
 use peritherm::math::Point;
+use peritherm::series::SeriesCheck;
 
 const THETA0: f64 = 100.0;
 const T: f64 = 0.01;

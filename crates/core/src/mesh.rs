@@ -1,6 +1,6 @@
 //! Unstructured meshes as read from a file: nodes, elements and named physical groups.
 //!
-//! This is the neutral form between a mesh reader ([`crate::gmsh`]) and the cloud builder
+//! This is the neutral form between a mesh reader (`peritherm_io::gmsh`) and the cloud builder
 //! ([`crate::cloud::mesh`]); it holds no physics. Element geometry (centroid, measure) lives
 //! here because every consumer needs the same formulas.
 

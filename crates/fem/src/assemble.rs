@@ -11,10 +11,10 @@
 //! quadrature point ([`FemMesh::symmetry_weight`]): K_ab = ∫ k ∇N_a·∇N_b 2πr dr dz is the
 //! Galerkin form of ρc θ_t = (1/r)(r k θ_r)_r + (k θ_z)_z (and of (1/r²)(r² k θ_r)_r).
 
-use super::mesh::FemMesh;
-use super::shape::{physical, quadrature_for, shape, MAX_NODES};
-use crate::material::Material;
-use crate::math::{Point, Vector};
+use crate::mesh::FemMesh;
+use crate::shape::{physical, quadrature_for, shape, MAX_NODES};
+use peritherm_core::material::Material;
+use peritherm_core::math::{Point, Vector};
 use rayon::prelude::*;
 
 /// Entries per element matrix slot (8 × 8).

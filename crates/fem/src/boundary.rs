@@ -8,12 +8,12 @@
 //! and on axisymmetric or spherical meshes so does the ring or shell measure 2πr or 4πr² at
 //! each quadrature point (a flux q on the face r = a loads 2πa q per unit length of axis).
 
-use super::assemble::System;
-use super::mesh::{FacetRef, FemMesh};
-use super::shape::{facet_density, physical, quadrature, quadrature_for, shape, MAX_NODES};
-use crate::bc::FaceBc;
-use crate::expr::Expr;
-use crate::math::Point;
+use crate::assemble::System;
+use crate::mesh::{FacetRef, FemMesh};
+use crate::shape::{facet_density, physical, quadrature, quadrature_for, shape, MAX_NODES};
+use peritherm_core::bc::FaceBc;
+use peritherm_core::expr::Expr;
+use peritherm_core::math::Point;
 
 /// One quadrature point of a load integral: where, its weight (m², m³ with τ) and the shape
 /// functions of the nodes it feeds.
@@ -76,7 +76,7 @@ fn facet_points(mesh: &FemMesh, f: FacetRef) -> Vec<QPoint> {
             let pos = Point::from(
                 (0..len)
                     .map(|a| x[a].coords * s.n[a])
-                    .sum::<crate::math::Vector>(),
+                    .sum::<peritherm_core::math::Vector>(),
             );
             QPoint {
                 pos,
@@ -100,7 +100,7 @@ fn cell_points(mesh: &FemMesh) -> Vec<QPoint> {
             let pos = Point::from(
                 (0..len)
                     .map(|a| x[a].coords * s.n[a])
-                    .sum::<crate::math::Vector>(),
+                    .sum::<peritherm_core::math::Vector>(),
             );
             out.push(QPoint {
                 pos,

@@ -12,13 +12,13 @@
 //! spacing off it, towards the centre of the cells it belongs to, so that readers that tell
 //! the crack's sides apart by position (`peritherm compare`, `plot`) put it on its own side.
 
-use super::assemble::System;
-use super::mesh::FemMesh;
-use super::shape::{centre, physical, shape, MAX_NODES};
-use crate::cloud::Cloud;
-use crate::material::Material;
-use crate::math::{Point, Vector};
-use crate::mesh::measure_and_centroid;
+use crate::assemble::System;
+use crate::mesh::FemMesh;
+use crate::shape::{centre, physical, shape, MAX_NODES};
+use peritherm_core::cloud::Cloud;
+use peritherm_core::material::Material;
+use peritherm_core::math::{Point, Vector};
+use peritherm_core::mesh::measure_and_centroid;
 
 /// Flux recovery data: per cell, k∇N_a at its centre; per node, the cells around it with weights.
 #[derive(Debug, Clone)]

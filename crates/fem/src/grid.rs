@@ -6,13 +6,13 @@
 //! breakpoints is divided into the fewest equal cells no longer than `h`, so region interfaces
 //! and cracks lie on grid lines by construction.
 
-use super::mesh::{Cell, FemMesh};
-use super::shape::MAX_NODES;
-use crate::cloud::BoxGeometry;
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::mesh::ElementKind;
-use crate::model::{Crack, CrackShape};
+use crate::mesh::{Cell, FemMesh};
+use crate::shape::MAX_NODES;
+use peritherm_core::cloud::BoxGeometry;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
+use peritherm_core::mesh::ElementKind;
+use peritherm_core::model::{Crack, CrackShape};
 
 /// Relative tolerance for breakpoints that coincide, of the domain's largest side.
 const REL: f64 = 1e-9;
@@ -187,7 +187,7 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
         nodes,
         cells,
         sets: vec![Vec::new(); 6],
-        symmetry: crate::symmetry::Symmetry::Planar,
+        symmetry: peritherm_core::symmetry::Symmetry::Planar,
     };
     // boundary facets: facets of one cell only, classified by the face plane they lie on
     let map = m.facet_map();
@@ -220,7 +220,7 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cloud::{BoxRegion, HorizonRule};
+    use peritherm_core::cloud::{BoxRegion, HorizonRule};
 
     fn region(name: &str, min: [f64; 3], max: [f64; 3], cells: [usize; 3]) -> BoxRegion {
         BoxRegion {

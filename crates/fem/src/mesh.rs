@@ -2,15 +2,15 @@
 //! the boundary sets as lists of cell facets.
 //!
 //! Boundary facets are stored as (cell, local facet) rather than as node lists, so that
-//! splitting the mesh along a crack ([`super::split`]) renumbers them for free.
+//! splitting the mesh along a crack ([`crate::split`]) renumbers them for free.
 
-use super::shape::{facet_kind, facets, MAX_NODES};
-use crate::cloud::mesh::MeshGeometry;
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::mesh::ElementKind;
-use crate::spatial::PointIndex;
-use crate::symmetry::Symmetry;
+use crate::shape::{facet_kind, facets, MAX_NODES};
+use peritherm_core::cloud::mesh::MeshGeometry;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
+use peritherm_core::mesh::ElementKind;
+use peritherm_core::spatial::PointIndex;
+use peritherm_core::symmetry::Symmetry;
 use std::collections::HashMap;
 
 /// One cell: its kind, node indices (the first `kind.n_nodes()` are used), region and material.
@@ -214,7 +214,7 @@ impl FemMesh {
                 corners
                     .iter()
                     .map(|p| p.coords)
-                    .sum::<crate::math::Vector>()
+                    .sum::<peritherm_core::math::Vector>()
                     / corners.len() as f64,
             )];
             if corners.len() > 2 {

@@ -6,9 +6,9 @@
 //! degree 2 exactly, enough for the consistent mass of linear elements and the stiffness of
 //! bilinear/trilinear ones on parallelogram cells (Gauss 2 × 2 (× 2) is exact there too).
 
-use crate::math::{Point, Vector};
-use crate::mesh::ElementKind;
-use crate::symmetry::Symmetry;
+use peritherm_core::math::{Point, Vector};
+use peritherm_core::mesh::ElementKind;
+use peritherm_core::symmetry::Symmetry;
 
 /// Most nodes of an element (the hexahedron).
 pub const MAX_NODES: usize = 8;

@@ -12,14 +12,14 @@
 //! the held values excites, which Crank–Nicolson alone leaves ringing when Δt ≫ h²/α, and
 //! keep the scheme second order.
 
-use super::assemble::System;
-use super::boundary::Conditions;
-use super::mesh::FemMesh;
-use crate::error::{Error, Result};
+use crate::assemble::System;
+use crate::boundary::Conditions;
+use crate::mesh::FemMesh;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Conj, Side};
+use peritherm_core::error::{Error, Result};
 
 /// A sparse Cholesky factor L Lᵀ with the scratch memory its solves need, so that solving
 /// allocates nothing.

@@ -7,11 +7,11 @@
 //! cells connect around it) and stays shared; a node inside the crack, or where the crack
 //! meets the boundary, has two and is duplicated.
 
-use super::mesh::{key_of, FacetKey, FemMesh};
-use super::shape::facets;
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::model::{Crack, CrackShape};
+use crate::mesh::{key_of, FacetKey, FemMesh};
+use crate::shape::facets;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
+use peritherm_core::model::{Crack, CrackShape};
 use std::collections::{HashMap, HashSet};
 
 /// Relative tolerance (of the mesh's largest extent) for a node lying on a crack segment.

@@ -3,24 +3,24 @@
 //! Every key is documented in docs/case-reference.md. Unknown keys, missing
 //! fields and out-of-range values are errors that name the file and the key.
 
-use crate::analytic::Reference;
-use crate::bc::{FaceBc, Layer};
-use crate::cloud::mesh::{MeshGeometry, MeshRegion};
-use crate::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
-use crate::crack::Growth;
-use crate::error::{Error, Result};
-use crate::expr::Expr;
-use crate::fem::run::FemOptions;
-use crate::fem::solve::Scheme;
 use crate::history::{HistoryPlot, HistorySpec};
-use crate::kernel::{Calibration, Kernel, PartialVolume, Profile};
-use crate::material::{BondRule, Material};
-use crate::math::Point;
-use crate::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
 use crate::reference::ReferenceTable;
-use crate::solve::explicit::Integrator;
-use crate::symmetry::Symmetry;
-use crate::weights::Order;
+use crate::series::SeriesCheck;
+use peritherm_core::analytic::Reference;
+use peritherm_core::bc::{FaceBc, Layer};
+use peritherm_core::cloud::mesh::{MeshGeometry, MeshRegion};
+use peritherm_core::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
+use peritherm_core::crack::Growth;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::expr::Expr;
+use peritherm_core::kernel::{Calibration, Kernel, PartialVolume, Profile};
+use peritherm_core::material::{BondRule, Material};
+use peritherm_core::math::Point;
+use peritherm_core::model::{Crack, CrackShape, Geometry, Initial, ModelSpec};
+use peritherm_core::solve::explicit::Integrator;
+use peritherm_core::symmetry::Symmetry;
+use peritherm_core::weights::Order;
+use peritherm_fem::{FemOptions, Scheme};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -260,7 +260,7 @@ fn unnamed_insulated(
     for (s, face) in faces.iter_mut().enumerate() {
         let name = names
             .get(s)
-            .map_or(crate::cloud::mesh::UNNAMED, String::as_str);
+            .map_or(peritherm_core::cloud::mesh::UNNAMED, String::as_str);
         let given = named.contains_key(name);
         if !given && !cracked.contains(&s) {
             *face = FaceBc::LayerInsulated;
@@ -444,7 +444,7 @@ pub struct FemReferenceSpec {
 /// Where the classical temperatures of a reference come from.
 #[derive(Debug, Clone)]
 pub enum ReferenceSource {
-    /// An analytical series of [`crate::analytic`].
+    /// An analytical series of [`peritherm_core::analytic`].
     Analytic(Reference),
     /// A table exported by another code, interpolated at the nodes.
     Table(Arc<ReferenceTable>),
@@ -497,7 +497,7 @@ pub struct Case {
     /// Temperature histories, if any.
     pub history: Option<HistorySpec>,
     /// The model's estimated size, checked against the memory before it is built.
-    pub budget: crate::budget::Estimate,
+    pub budget: peritherm_core::budget::Estimate,
     /// The case file's text as read (a run writes it into its directory as `case.toml`).
     pub source: String,
     /// The other files the case reads (mesh, reference table, FEM mesh), resolved.
@@ -605,13 +605,13 @@ fn reference(
                 "must be finite coordinates of a 2D or 3D case",
             ));
         }
-        if v.len() > crate::limits::MAX_HISTORY_POINTS {
+        if v.len() > peritherm_core::limits::MAX_HISTORY_POINTS {
             return Err(case_err(
                 path,
                 key,
                 format!(
                     "at most {} lines, got {}",
-                    crate::limits::MAX_HISTORY_POINTS,
+                    peritherm_core::limits::MAX_HISTORY_POINTS,
                     v.len()
                 ),
             ));
@@ -670,7 +670,7 @@ fn reference(
 }
 
 /// Validates `[history]`: at least one point inside the case's dimension, a positive
-/// interval giving at most [`crate::limits::MAX_HISTORY_ROWS`] rows, a known plot.
+/// interval giving at most [`peritherm_core::limits::MAX_HISTORY_ROWS`] rows, a known plot.
 fn history(
     h: HistorySection,
     path: &Path,
@@ -685,13 +685,13 @@ fn history(
             "a steady solve has no history; use a transient integrator",
         ));
     }
-    if h.points.is_empty() || h.points.len() > crate::limits::MAX_HISTORY_POINTS {
+    if h.points.is_empty() || h.points.len() > peritherm_core::limits::MAX_HISTORY_POINTS {
         return Err(case_err(
             path,
             "history.points",
             format!(
                 "give 1 to {} points, got {}",
-                crate::limits::MAX_HISTORY_POINTS,
+                peritherm_core::limits::MAX_HISTORY_POINTS,
                 h.points.len()
             ),
         ));
@@ -703,7 +703,7 @@ fn history(
     }
     let interval = positive(path, "history.interval", h.interval)?;
     let last = outputs.last().copied().unwrap_or(interval);
-    let max = crate::limits::MAX_HISTORY_ROWS / points.len() as f64;
+    let max = peritherm_core::limits::MAX_HISTORY_ROWS / points.len() as f64;
     let times = crate::history::sample_times(interval, last, max)
         .map_err(|m| case_err(path, "history.interval", m))?;
     let plot = match h.plot.as_deref() {
@@ -972,7 +972,7 @@ impl CaseFile {
                 horizon: rules[r].0,
                 material: rules[r].1,
             };
-            crate::budget::check_horizon(dim, region.spacing(), &region.horizon)
+            peritherm_core::budget::check_horizon(dim, region.spacing(), &region.horizon)
                 .map_err(|m| err(&horizon_key(r, reg), m))?;
             regions.push(region);
         }
@@ -1412,7 +1412,8 @@ impl CaseFile {
         for (name, b) in &self.boundary {
             let key = |k: &str| format!("boundary.{name}.{k}");
             // on a mesh, `[boundary."(no group)"]` names the facets in no group
-            let unnamed = (mesh && name == crate::cloud::mesh::UNNAMED).then_some(set_names.len());
+            let unnamed =
+                (mesh && name == peritherm_core::cloud::mesh::UNNAMED).then_some(set_names.len());
             let f = set_names.iter().position(|n| n == name).or(unnamed).ok_or_else(|| {
                 let what = match &geometry {
                     Geometry::Box(_) if FACE_NAMES.contains(&name.as_str()) => {
@@ -1658,7 +1659,7 @@ impl CaseFile {
             Some(h) => Some(history(h, path, dim, &outputs, integrator)?),
             None => None,
         };
-        let budget = crate::budget::estimate(&spec, &size_keys, integrator.is_implicit())
+        let budget = peritherm_core::budget::estimate(&spec, &size_keys, integrator.is_implicit())
             .map_err(|e| in_case(path, e))?;
         Ok(Case {
             path: path.to_path_buf(),

@@ -1,4 +1,4 @@
-//! Reading gmsh MSH 4.1 files (ASCII and binary) into a [`crate::mesh::Mesh`].
+//! Reading gmsh MSH 4.1 files (ASCII and binary) into a [`peritherm_core::mesh::Mesh`].
 //!
 //! The format is specified in the gmsh reference manual, section "MSH file format"
 //! (<https://gmsh.info/doc/texinfo/gmsh.html#MSH-file-format>). The `$Entities`, `$Nodes` and
@@ -15,9 +15,9 @@ use std::path::Path;
 
 use mshio::{ElementType, MshFile, MshParserError};
 
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::mesh::{Element, ElementKind, Group, Mesh};
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
+use peritherm_core::mesh::{Element, ElementKind, Group, Mesh};
 
 /// Physical group names by (dimension, tag).
 type Names = BTreeMap<(i32, i32), String>;

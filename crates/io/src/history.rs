@@ -8,11 +8,11 @@
 //! to the last output, and the output times; `reference` is empty when the case has no
 //! analytical reference (tables and the FEM are fields at the output times only).
 
-use crate::analytic::Reference;
-use crate::cloud::Cloud;
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::output::write_atomic;
+use crate::atomic::write_atomic;
+use peritherm_core::analytic::Reference;
+use peritherm_core::cloud::Cloud;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -223,7 +223,7 @@ pub fn read(dir: &Path) -> Result<Vec<Curves>> {
 /// than `max` of them.
 pub fn sample_times(interval: f64, last: f64, max: f64) -> std::result::Result<Vec<f64>, String> {
     let n = (last / interval * (1.0 + 1e-12)).floor();
-    if !crate::limits::within(n, max) {
+    if !peritherm_core::limits::within(n, max) {
         return Err(format!(
             "{n:e} samples up to the last output {last} s; at most {max:e} are allowed"
         ));

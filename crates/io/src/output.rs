@@ -7,29 +7,13 @@
 //! (also one that fails or is interrupted) writes `case.toml`, the text of its case
 //! ([`crate::provenance`]).
 
-use crate::cloud::Cloud;
-use crate::error::{Error, Result};
-use crate::math::{Point, Vector};
+use crate::atomic::write_atomic;
+use peritherm_core::cloud::Cloud;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::{Point, Vector};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// Writes `bytes` to a temporary file beside `path`, then renames it into place.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial"));
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        error: source,
-    };
-    // an interrupt waits for this write to end ([`crate::staging::interrupt`])
-    let _guard = crate::staging::writing();
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
-}
 
 /// A time (s) or coordinate (m) as tables, legends and file names show it: plainly (`0.5`,
 /// `0.00005`), or in exponent form below 1e-6 (`2e-13`, where the plain form is a row of
@@ -351,10 +335,25 @@ pub struct CaseOrigin {
     pub inputs: Vec<FileStamp>,
 }
 
+/// `run.json` of a run that did not complete.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Unfinished {
+    /// `interrupted` or `failed`.
+    pub status: String,
+    /// Case file.
+    pub case: String,
+    /// Simulated time reached, s.
+    pub time: f64,
+    /// Why it stopped.
+    pub message: String,
+    /// The complete field files it wrote, in output order.
+    pub fields: Vec<String>,
+}
+
 /// Summary written to run.json.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunSummary {
-    /// `complete` (an unfinished run's run.json is a [`crate::staging::Unfinished`]).
+    /// `complete` (an unfinished run's run.json is a [`Unfinished`]).
     #[serde(default = "complete")]
     pub status: String,
     /// Case title.
@@ -402,13 +401,13 @@ pub struct RunSummary {
     /// Consistent-weights correction: nodes corrected and left out, moment errors before and
     /// after, iterations, and the range of factors applied to the pair conductances.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub consistency: Option<crate::weights::Consistency>,
+    pub consistency: Option<peritherm_core::weights::Consistency>,
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,
     /// Implicit runs: solves, factorisations, accepted and rejected steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub implicit: Option<crate::solve::implicit::ImplicitStats>,
+    pub implicit: Option<peritherm_core::solve::implicit::ImplicitStats>,
     /// The `[history]` samples: their file and, per point, peaks and differences.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<crate::history::HistorySummary>,
@@ -445,7 +444,7 @@ impl RunSummary {
             .map(str::to_string);
         if let Some(status) = status {
             if status != "complete" {
-                let u: crate::staging::Unfinished =
+                let u: Unfinished =
                     serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
                 return Err(bad(format!(
                     "the run of {} is {status} at t = {:e} s ({}); it has no results to read, run it again",

@@ -4,9 +4,10 @@
 //! table). `compare`, `plot` and `report` load the case from that copy, from any working
 //! directory, and refuse with a clear line when an input file changed since the run.
 
+use crate::atomic::write_atomic;
 use crate::case::Case;
-use crate::error::{Error, Result};
-use crate::output::{write_atomic, CaseOrigin, FileStamp, RunSummary};
+use crate::output::{CaseOrigin, FileStamp, RunSummary};
+use peritherm_core::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// File name of the case copy in a run's directory.

@@ -1,13 +1,13 @@
 //! Reference solutions exported by other codes (ANSYS, Abaqus, FEniCS, …) as CSV tables:
-//! reading and checking them. Interpolation onto the PD nodes is in [`crate::report`].
+//! reading and checking them. Interpolation onto the PD nodes is in `peritherm_post::report`.
 //!
 //! Format: a header naming the columns `time`, the coordinates (`x`; `x,y`; `x,y,z` for the
 //! case's dimension) and `temperature`, in any order (other columns are ignored), then one
 //! row per point and output time. Units as the case (s, m, °C). Lines starting with `#` are
 //! comments.
 
-use crate::error::{Error, Result};
-use crate::math::Point;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
 use std::path::{Path, PathBuf};
 
 /// The points and temperatures of a reference at one time.

@@ -10,26 +10,19 @@
 //!
 //! An existing `--out` is only replaced when it holds nothing but peritherm output.
 
-use crate::error::{Error, Result};
-use serde::{Deserialize, Serialize};
+use crate::atomic::writing;
+use crate::output::Unfinished;
+use peritherm_core::error::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
-/// Held while a file is written and while a directory is swapped in; the interrupt handler
-/// takes it and never lets go, so no write is cut in half and none starts after it.
-static WRITING: Mutex<()> = Mutex::new(());
 /// Staged directories of the runs under way, outermost first.
 static ACTIVE: Mutex<Vec<(PathBuf, PathBuf, String)>> = Mutex::new(Vec::new());
 /// Simulated time the innermost run has reached, s (as f64 bits).
 static REACHED: AtomicU64 = AtomicU64::new(0);
 /// Distinguishes the staged directories of one process.
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-/// The lock of `WRITING`, poisoned or not.
-pub fn writing() -> MutexGuard<'static, ()> {
-    WRITING.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 fn active() -> MutexGuard<'static, Vec<(PathBuf, PathBuf, String)>> {
     ACTIVE.lock().unwrap_or_else(|e| e.into_inner())
@@ -38,21 +31,6 @@ fn active() -> MutexGuard<'static, Vec<(PathBuf, PathBuf, String)>> {
 /// Records the simulated time a run has reached, s (reported if it is interrupted).
 pub fn reached(t: f64) {
     REACHED.store(t.to_bits(), Ordering::Relaxed);
-}
-
-/// `run.json` of a run that did not complete.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Unfinished {
-    /// `interrupted` or `failed`.
-    pub status: String,
-    /// Case file.
-    pub case: String,
-    /// Simulated time reached, s.
-    pub time: f64,
-    /// Why it stopped.
-    pub message: String,
-    /// The complete field files it wrote, in output order.
-    pub fields: Vec<String>,
 }
 
 /// Names an output directory may hold and still be replaced: a run's own files.

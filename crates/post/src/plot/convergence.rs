@@ -3,7 +3,7 @@
 use super::line::check_series;
 use super::FONT;
 use super::{extent, palette, plot_error, render, sci, DrawError, Figure, Labels, Legend, Series};
-use crate::error::{Error, Result};
+use peritherm_core::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

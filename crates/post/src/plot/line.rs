@@ -1,7 +1,7 @@
 //! Line plots: several named series of (x, y) points as lines and/or markers.
 
 use super::{extent, palette, plot_error, render, tick_label, DrawError, Figure, Labels, FONT};
-use crate::error::Result;
+use peritherm_core::error::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -2,9 +2,9 @@
 //! colour bar, axes, optional region outlines, crack segments and heat-flux arrows.
 
 use super::{extent, plot_error, render, tick_label, widen, ColourMap, DrawError, Figure, FONT};
-use crate::error::Result;
-use crate::math::{Point, Vector};
-use crate::spatial::PointIndex;
+use peritherm_core::error::Result;
+use peritherm_core::math::{Point, Vector};
+use peritherm_core::spatial::PointIndex;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! plots with fitted power-law rates ([`convergence_plot`], [`fit_rate`]) and 2D maps of a
 //! node cloud ([`field_map`]). Data in, files out: every plot writes `<stem>.png` and
 //! `<stem>.svg`; no physics and no case files here. Text uses the bundled DejaVu Sans
-//! (`assets/fonts/`), so it renders on machines without system fonts.
+//! (`crates/post/assets/fonts/`), so it renders on machines without system fonts.
 
 mod colour;
 mod convergence;
@@ -14,7 +14,7 @@ pub use convergence::{convergence_plot, fit_power_law, fit_rate, PowerLaw};
 pub use line::{line_plot, Legend, Series, Style};
 pub use map::{field_map, isoline, FieldMap, IRREGULAR_SQUARE};
 
-use crate::error::{Error, Result};
+use peritherm_core::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -24,7 +24,7 @@ use std::sync::OnceLock;
 /// Font family name under which the bundled font is registered (and named in the SVG).
 pub const FONT: &str = "sans-serif";
 
-/// The bundled font (DejaVu Sans 2.37, Bitstream Vera licence: `assets/fonts/`).
+/// The bundled font (DejaVu Sans 2.37, Bitstream Vera licence: `crates/post/assets/fonts/`).
 static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Registers the bundled font once; false if it could not be parsed.

@@ -3,14 +3,14 @@
 
 pub mod page;
 
-use crate::case::{ReferenceSource, ReferenceSpec};
-use crate::cloud::Cloud;
-use crate::crack::Cutter;
-use crate::error::{Error, Result};
-use crate::math::Point;
-use crate::output::{Comparison, Probe};
-use crate::reference::covered_box;
-use crate::spatial::PointIndex;
+use peritherm_core::cloud::Cloud;
+use peritherm_core::crack::Cutter;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::Point;
+use peritherm_core::spatial::PointIndex;
+use peritherm_io::case::{ReferenceSource, ReferenceSpec};
+use peritherm_io::output::{Comparison, Probe};
+use peritherm_io::reference::covered_box;
 use rayon::prelude::*;
 
 /// The classical temperatures at the body nodes of `cloud` at time `t`, °C: the analytical
@@ -299,7 +299,7 @@ fn fit_at(dim: usize, x: &Point, near: &[(usize, f64)], b: (&[Point], &[f64])) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analytic::Reference;
+    use peritherm_core::analytic::Reference;
 
     /// The axisymmetric phase-change paper, eq. 27 by its definition: a field off the reference by
     /// the same d at every node has rms d, so ε = d / max |T_ref| whatever the field; a difference

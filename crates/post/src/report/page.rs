@@ -2,15 +2,16 @@
 //! error along them, maps of temperature (and damage and heat flux for cracked bodies), and
 //! `report.md` plus `index.html` showing them with the metrics and the run's settings.
 
-use crate::case::Case;
-use crate::crack::segments_at;
-use crate::error::Result;
-use crate::math::Point;
-use crate::model::crack_cutters;
-use crate::output::{number_label, write_atomic, FieldRows, RunSummary};
 use crate::plot::{
     field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
+use peritherm_core::crack::segments_at;
+use peritherm_core::error::Result;
+use peritherm_core::math::Point;
+use peritherm_core::model::crack_cutters;
+use peritherm_io::atomic::write_atomic;
+use peritherm_io::case::Case;
+use peritherm_io::output::{number_label, FieldRows, RunSummary};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -188,7 +189,7 @@ pub fn draw_history(
     dir: &Path,
     reference_name: &str,
 ) -> Result<Vec<PathBuf>> {
-    let curves = crate::history::read(run)?;
+    let curves = peritherm_io::history::read(run)?;
     let end = curves
         .iter()
         .flat_map(|c| c.1.iter().map(|p| p.0))
@@ -197,7 +198,7 @@ pub fn draw_history(
     let normalised = case
         .history
         .as_ref()
-        .is_some_and(|h| h.plot == crate::history::HistoryPlot::Normalised);
+        .is_some_and(|h| h.plot == peritherm_io::history::HistoryPlot::Normalised);
     let mut stems = Vec::new();
     for norm in [false, true] {
         if norm && !normalised {
@@ -286,7 +287,7 @@ pub fn write_report(
     reference_name: &str,
     extra: Option<(&Path, &str)>,
 ) -> Result<Written> {
-    std::fs::create_dir_all(dir).map_err(|error| crate::error::Error::Io {
+    std::fs::create_dir_all(dir).map_err(|error| peritherm_core::error::Error::Io {
         path: dir.to_path_buf(),
         error,
     })?;
@@ -563,7 +564,10 @@ fn page(w: &Written, case: &Case, run: &Path, reference_name: &str) -> (String, 
 
 /// The Markdown and HTML of the history's summary: per point, the node, the PD and reference
 /// peaks, and the largest differences of the curves and of the normalised curves.
-fn history_table(h: &crate::history::HistorySummary, reference_name: &str) -> (String, String) {
+fn history_table(
+    h: &peritherm_io::history::HistorySummary,
+    reference_name: &str,
+) -> (String, String) {
     const HEADER: [&str; 6] = [
         "node (m)",
         "PD peak (°C)",
