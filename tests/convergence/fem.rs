@@ -1,4 +1,4 @@
-//! The built-in classical FEM solver (`peritherm fem`, src/fem/): second-order convergence in
+//! The built-in classical FEM solver (`peritherm fem`, crates/fem/src/): second-order convergence in
 //! space against the analytical square and bar, the Bobaru & Duangpanya 2012 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!

@@ -1,5 +1,5 @@
 //! The series references of the mesh-convergence suite (`box_fixed_faces`, `disc_fixed_edge`
-//! in src/analytic.rs), and of the laser film and the split thermal shock (`film_laser_pulse`,
+//! in crates/core/src/analytic.rs), and of the laser film and the split thermal shock (`film_laser_pulse`,
 //! `plate_pulse_split`), against independent finite-difference solves
 //! (tests/common/heat_fd.rs).
 //!
