@@ -6,43 +6,30 @@
 //! Oterkus's dual-horizon thermal diffusion; the full references are at the end of
 //! `docs/theory.md`.
 //!
+//! This package is the command line (`peritherm`, with `bench`) and the drivers that run a
+//! case ([`run`], [`sweep`], [`prepare`], [`bench`](mod@bench), [`fem::run`]); it re-exports the
+//! modules of the layers below it under their old paths (`peritherm::cloud`,
+//! `peritherm::case`, …): the numerics (`peritherm-core`), the classical FEM reference
+//! (`peritherm-fem`), the inputs and outputs (`peritherm-io`) and the post-processing
+//! (`peritherm-post`); `docs/architecture.md` describes the layers.
+//!
 //! Flow: [`case`] (TOML) → [`model::ModelSpec`] → [`cloud`] → [`neighbors`] →
 //! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.
 #![warn(missing_docs)]
 
-pub mod analytic;
-pub mod bc;
+pub use peritherm_core::{
+    analytic, bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model,
+    neighbors, operator, solve, spatial, stencil, symmetry, weights,
+};
+pub use peritherm_io::{
+    atomic, case, gmsh, history, output, provenance, reference, series, staging,
+};
+pub use peritherm_post::{plot, report};
+
 pub mod bench;
-pub mod budget;
-pub mod case;
-pub mod cloud;
-pub mod crack;
-pub mod error;
-pub mod expr;
 pub mod fem;
-pub mod gmsh;
-pub mod history;
-pub mod kernel;
-pub mod limits;
-pub mod material;
-pub mod math;
-pub mod mesh;
-pub mod model;
-pub mod neighbors;
-pub mod operator;
-pub mod output;
-pub mod plot;
 pub mod prepare;
-pub mod provenance;
-pub mod reference;
-pub mod report;
 pub mod run;
-pub mod solve;
-pub mod spatial;
-pub mod staging;
-pub mod stencil;
 pub mod sweep;
-pub mod symmetry;
-pub mod weights;
 
 pub use error::{Error, Result};

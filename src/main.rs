@@ -571,8 +571,8 @@ fn sweep(
             table.push_str(&format!("![{p}]({p}.png)\n\n"));
         }
     }
-    peritherm::output::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
-    peritherm::output::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    peritherm::atomic::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
+    peritherm::atomic::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
     say!("{table}");
     say!("-> {}", out.join("sweep.md").display());
     Ok(())

@@ -1,5 +1,6 @@
 //! Running a case end to end: build, integrate, write fields and the summary.
 
+use crate::atomic::write_atomic;
 use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::crack::tips_at;
 use crate::error::{Error, Result};
@@ -8,7 +9,7 @@ use crate::history::{output_index, Recorder};
 use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::output::read_field;
-use crate::output::{field_csv, field_path, field_vtu, vtu_path, write_atomic, Fields, RunSummary};
+use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, RunSummary};
 use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};

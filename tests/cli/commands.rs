@@ -527,15 +527,19 @@ fn compare_and_plot_work_from_any_directory() {
 }
 
 /// docs/case-reference.md names every key of the case schema: each field of a struct that
-/// the case file is read into (`deny_unknown_fields` in src/case.rs, src/material.rs,
-/// src/analytic.rs) appears in backticks, alone or as the last part of a dotted key.
+/// the case file is read into (`deny_unknown_fields` in crates/io/src/case.rs, crates/core/src/material.rs,
+/// crates/core/src/analytic.rs) appears in backticks, alone or as the last part of a dotted key.
 #[test]
 fn the_case_reference_lists_every_schema_key() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let doc = std::fs::read_to_string(root.join("docs/case-reference.md")).unwrap();
     let mut missing = Vec::new();
     let mut checked = 0;
-    for file in ["src/case.rs", "src/material.rs", "src/analytic.rs"] {
+    for file in [
+        "crates/io/src/case.rs",
+        "crates/core/src/material.rs",
+        "crates/core/src/analytic.rs",
+    ] {
         let text = std::fs::read_to_string(root.join(file)).unwrap();
         for key in schema_keys(&text) {
             checked += 1;

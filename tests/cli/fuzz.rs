@@ -17,7 +17,7 @@ const INPUTS: usize = 2400;
 /// One input's limit: a validation that takes longer counts as a hang. Honest inputs take
 /// milliseconds here (the budget below keeps the models small). One known input is slow:
 /// two node coordinates of the 64-element square swapped (a warped element) keep the
-/// consistent-weights solve (`src/weights`) busy for 9-13 s; 30 s leaves room for it on a
+/// consistent-weights solve (`crates/core/src/weights`) busy for 9-13 s; 30 s leaves room for it on a
 /// loaded machine. Inputs slower than a quarter of the limit are reported on stderr, their
 /// mesh kept in the temporary directory as `peritherm_fuzz_slow_<k>.msh`.
 const PER_INPUT: Duration = Duration::from_secs(30);

@@ -1,4 +1,4 @@
-//! The built-in classical FEM solver (`peritherm fem`, src/fem/): second-order convergence in
+//! The built-in classical FEM solver (`peritherm fem`, crates/fem/src/): second-order convergence in
 //! space against the analytical square and bar, the Bobaru & Duangpanya 2012 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!
@@ -9,9 +9,10 @@ use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
 use peritherm::case::Case;
-use peritherm::fem::run::FemModel;
+use peritherm::fem::run;
 use peritherm::fem::shape::shape;
 use peritherm::fem::solve::{Scheme, Stepper};
+use peritherm::fem::FemModel;
 use peritherm::mesh::ElementKind;
 use std::path::PathBuf;
 
@@ -61,7 +62,7 @@ fn integrate(model: &FemModel, scheme: Scheme, end: f64, n: usize) -> Vec<f64> {
 /// Max nodal error of a FEM solution of `c` at mesh size `h` and time `end` against the case's
 /// reference series (CN with `n` steps).
 fn max_error(c: &Case, h: f64, end: f64, n: usize) -> f64 {
-    let model = FemModel::build(c, Some(h)).unwrap();
+    let model = run::model(c, Some(h)).unwrap();
     let theta = integrate(&model, Scheme::CrankNicolson, end, n);
     let r = analytic(c);
     let pts = &model.mesh.nodes;
@@ -229,7 +230,7 @@ fn crack_plate_matches_finite_differences() {
     let c = Case::load(&root().join("cases/crack_plate.toml")).unwrap();
     let (a, tip, alpha) = (0.01, 0.005, 114.0 / 1e6);
     let nx = 200;
-    let model = FemModel::build(&c, Some(2.0 * a / nx as f64)).unwrap();
+    let model = run::model(&c, Some(2.0 * a / nx as f64)).unwrap();
     assert_eq!(
         model.split_nodes, 99,
         "the crack's interior nodes are duplicated, tips shared"
@@ -327,7 +328,7 @@ fn insulated_bodies_conserve_energy() {
     ];
     for case in &cases {
         let c = case.case(in_cases());
-        let model = FemModel::build(&c, None).unwrap();
+        let model = run::model(&c, None).unwrap();
         let e0 = model.energy(&model.theta0);
         let theta = integrate(&model, Scheme::BackwardEuler, c.end, 20);
         let e = model.energy(&theta);
@@ -484,7 +485,7 @@ fn unsupported_cases_give_clear_errors() {
 
 fn steady(text: &str) -> (FemModel, Vec<f64>) {
     let c = case(text);
-    let model = FemModel::build(&c, None).unwrap();
+    let model = run::model(&c, None).unwrap();
     let mut st = Stepper::new(
         &model.mesh,
         &model.system,
@@ -596,7 +597,7 @@ fn crack_plate_resolution_study() {
         study(format!("FD {n}²"), &|i, j, _, _| fd_at(*n, f, i, j));
     }
     for nx in [240, 480, 960] {
-        let model = FemModel::build(&c, Some(2.0 * a / nx as f64)).unwrap();
+        let model = run::model(&c, Some(2.0 * a / nx as f64)).unwrap();
         let mut st = Stepper::new(
             &model.mesh,
             &model.system,
@@ -629,7 +630,7 @@ fn cracks_split_what_they_should() {
         .section("[[crack]]\npoints = [[-0.5, 0.5], [0.4, 0.5], [0.4, 0.7], [1.5, 0.7]]")
         .initial("(y > 0.6) * 100")
         .case(in_cases());
-    let model = FemModel::build(&c, None).unwrap();
+    let model = run::model(&c, None).unwrap();
     let theta = integrate(&model, Scheme::BackwardEuler, 1.0, 50);
     let upper = |p: &peritherm::math::Point, cell_centre_y: f64| {
         if p.x < 0.4 {
@@ -680,7 +681,7 @@ fn cracks_split_what_they_should() {
             .section(&format!("[[crack]]\n{crack}"))
             .end(0.1)
             .case(in_cases());
-        FemModel::build(&c, None).unwrap().split_nodes
+        run::model(&c, None).unwrap().split_nodes
     };
     let by_group = gmsh("group = \"crack\"");
     let by_points = gmsh("points = [[-0.005, 0.0], [0.005, 0.0]]");
@@ -695,7 +696,7 @@ fn cracks_split_what_they_should() {
 #[test]
 fn crank_nicolson_start_damps_the_initial_jump() {
     let c = case(SQUARE);
-    let model = FemModel::build(&c, Some(1.0 / 32.0)).unwrap();
+    let model = run::model(&c, Some(1.0 / 32.0)).unwrap();
     let r = analytic(&c);
     let pts = &model.mesh.nodes;
     let exact = r.eval_many(pts, 0.02);
@@ -748,7 +749,7 @@ fn time_dependent_held_end_converges_at_second_order() {
 /// `exact(x, y)`, °C.
 fn steady_error(text: &str, h: f64, exact: &dyn Fn(f64, f64) -> f64) -> f64 {
     let c = case(text);
-    let model = FemModel::build(&c, Some(h)).unwrap();
+    let model = run::model(&c, Some(h)).unwrap();
     let mut st = Stepper::new(
         &model.mesh,
         &model.system,
@@ -892,7 +893,7 @@ fn sphere_converges_at_second_order() {
     let r = analytic(&c);
     let (mut bulk, mut centre) = (Vec::new(), Vec::new());
     for n in [40.0, 80.0, 160.0, 320.0] {
-        let model = FemModel::build(&c, Some(0.1 / n)).unwrap();
+        let model = run::model(&c, Some(0.1 / n)).unwrap();
         let theta = integrate(&model, Scheme::CrankNicolson, 10.0, STEPS);
         let pts = &model.mesh.nodes;
         let exact = r.eval_many(pts, 10.0);
@@ -940,7 +941,7 @@ fn reference_fem_mesh_solves_on_another_mesh() {
         peritherm::case::ReferenceSource::Fem(o) => o.clone(),
         _ => panic!("a FEM reference"),
     };
-    let model = FemModel::build_with(&c, &opts).unwrap();
+    let model = run::model_with(&c, &opts).unwrap();
     assert_eq!(model.mesh.nodes.len(), 41 * 41);
     let length = |s: usize| -> f64 {
         model.mesh.sets[s]

@@ -1,5 +1,5 @@
 //! The series references of the mesh-convergence suite (`box_fixed_faces`, `disc_fixed_edge`
-//! in src/analytic.rs), and of the laser film and the split thermal shock (`film_laser_pulse`,
+//! in crates/core/src/analytic.rs), and of the laser film and the split thermal shock (`film_laser_pulse`,
 //! `plate_pulse_split`), against independent finite-difference solves
 //! (tests/common/heat_fd.rs).
 //!
@@ -14,6 +14,7 @@
 use crate::common::heat_fd::{disc_fd, plate_held_left_fd, slab_source_fd, BoxFd};
 use peritherm::analytic::{AxisEnds, Reference};
 use peritherm::math::Point;
+use peritherm::series::SeriesCheck;
 
 const THETA0: f64 = 100.0;
 const T: f64 = 0.01;

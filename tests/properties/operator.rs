@@ -487,7 +487,7 @@ fn time_step_bound() {
     assert!(err.contains("exceeds the stable bound"), "{err}");
 }
 
-/// The linear-consistency correction (src/weights, order linear) keeps K symmetric bit for bit
+/// The linear-consistency correction (crates/core/src/weights, order linear) keeps K symmetric bit for bit
 /// and positive, conserves energy to round-off, and makes a linear field steady at every body
 /// node of a dual-horizon cloud with mirrored layers, interface included. Tolerance 1e-9 of
 /// the flow scale (the moments are met to 1e-10 relative).

@@ -1,4 +1,4 @@
-//! Consistent bond weights (src/weights) on gmsh meshes of every element kind: quadratic
+//! Consistent bond weights (crates/core/src/weights) on gmsh meshes of every element kind: quadratic
 //! fields integrated exactly, K symmetric and positive, energy conserved, the explicit bound
 //! still stable. The meshes are meshes/moments_*.msh (triangles, unstructured quadrangles,
 //! mixed, graded 4×, tetrahedra; the hexahedra of moments_hex.msh are the open case below).

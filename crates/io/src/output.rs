@@ -1,0 +1,575 @@
+//! Output files: fields as CSV, the run summary as JSON, each written atomically.
+//!
+//! Contract: for the k-th output time (k from 1), `field_<k>.csv` with the columns
+//! `x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz`, one row per body
+//! node, and the same fields as a VTK unstructured grid `field_<k>.vtu`; and `run.json`.
+//! A case with a `[history]` also writes `history.csv` ([`crate::history`]); every run
+//! (also one that fails or is interrupted) writes `case.toml`, the text of its case
+//! ([`crate::provenance`]).
+
+use crate::atomic::write_atomic;
+use peritherm_core::cloud::Cloud;
+use peritherm_core::error::{Error, Result};
+use peritherm_core::math::{Point, Vector};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A time (s) or coordinate (m) as tables, legends and file names show it: plainly (`0.5`,
+/// `0.00005`), or in exponent form below 1e-6 (`2e-13`, where the plain form is a row of
+/// zeros).
+pub fn number_label(t: f64) -> String {
+    if t != 0.0 && t.abs() < 1e-6 {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
+/// Path of the k-th field file (k from 1).
+pub fn field_path(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("field_{k}.csv"))
+}
+
+/// Path of the k-th VTK file (k from 1).
+pub fn vtu_path(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("field_{k}.vtu"))
+}
+
+/// One output time's body fields: temperature and what is derived from it.
+pub struct Fields<'a> {
+    /// Temperature of every node (body first), °C.
+    pub theta: &'a [f64],
+    /// Damage φ per body node (theory §5).
+    pub damage: &'a [f64],
+    /// Peridynamic heat flux per body node (theory §8), W/m².
+    pub flux: &'a [Vector],
+    /// The case's classical reference at each body node, °C, if it has one.
+    pub reference: Option<&'a [f64]>,
+}
+
+/// CSV text of the body nodes: position, temperature, region, spacing, horizon, volume,
+/// damage and heat flux, and the classical reference when the case has one.
+pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
+    let mut s = String::with_capacity(cloud.n_body * 140);
+    s.push_str("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz");
+    s.push_str(if f.reference.is_some() {
+        ",reference\n"
+    } else {
+        "\n"
+    });
+    for i in 0..cloud.n_body {
+        let (p, q) = (cloud.pos[i], f.flux[i]);
+        let _ = write!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            p.x,
+            p.y,
+            p.z,
+            f.theta[i],
+            cloud.region[i],
+            cloud.spacing[i],
+            cloud.horizon[i],
+            cloud.volume[i],
+            f.damage[i],
+            q.x,
+            q.y,
+            q.z
+        );
+        match f.reference {
+            Some(r) => {
+                let _ = writeln!(s, ",{}", r[i]);
+            }
+            None => s.push('\n'),
+        }
+    }
+    s
+}
+
+const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Appends the standard base64 encoding of `bytes` (with padding).
+fn base64(bytes: &[u8], out: &mut String) {
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(B64[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+}
+
+/// A VTK XML `DataArray` in inline binary form: base64 of the byte count (UInt64), then
+/// base64 of the little-endian values, encoded separately as VTK's own writer does.
+fn vtk_array(out: &mut String, kind: &str, name: &str, comps: usize, bytes: &[u8]) {
+    let _ = write!(
+        out,
+        "<DataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">"
+    );
+    base64(&(bytes.len() as u64).to_le_bytes(), out);
+    base64(bytes, out);
+    out.push_str("</DataArray>\n");
+}
+
+fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
+    v.flat_map(f64::to_le_bytes).collect()
+}
+
+/// A VTK unstructured grid (`.vtu`) of the body nodes as vertices, with temperature, heat
+/// flux, damage, the classical reference (if any), horizon, spacing, volume and region, for
+/// ParaView.
+pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
+    let n = cloud.n_body;
+    let mut s = String::with_capacity(n * 140);
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n");
+    let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">");
+    s.push_str("<PointData Scalars=\"temperature\" Vectors=\"flux\">\n");
+    vtk_array(
+        &mut s,
+        "Float64",
+        "temperature",
+        1,
+        &f64_bytes(f.theta[..n].iter().copied()),
+    );
+    let flux = f.flux.iter().flat_map(|q| [q.x, q.y, q.z]);
+    vtk_array(&mut s, "Float64", "flux", 3, &f64_bytes(flux));
+    vtk_array(
+        &mut s,
+        "Float64",
+        "damage",
+        1,
+        &f64_bytes(f.damage.iter().copied()),
+    );
+    if let Some(r) = f.reference {
+        vtk_array(
+            &mut s,
+            "Float64",
+            "reference",
+            1,
+            &f64_bytes(r.iter().copied()),
+        );
+    }
+    for (name, v) in [
+        ("horizon", &cloud.horizon),
+        ("spacing", &cloud.spacing),
+        ("volume", &cloud.volume),
+    ] {
+        vtk_array(
+            &mut s,
+            "Float64",
+            name,
+            1,
+            &f64_bytes(v[..n].iter().copied()),
+        );
+    }
+    let region: Vec<u8> = cloud.region[..n]
+        .iter()
+        .flat_map(|r| (*r as i32).to_le_bytes())
+        .collect();
+    vtk_array(&mut s, "Int32", "region", 1, &region);
+    s.push_str("</PointData>\n<Points>\n");
+    let pos = cloud.pos[..n].iter().flat_map(|p| [p.x, p.y, p.z]);
+    vtk_array(&mut s, "Float64", "Points", 3, &f64_bytes(pos));
+    s.push_str("</Points>\n<Cells>\n");
+    let ids: Vec<u8> = (0..n as i64).flat_map(i64::to_le_bytes).collect();
+    vtk_array(&mut s, "Int64", "connectivity", 1, &ids);
+    let offsets: Vec<u8> = (1..=n as i64).flat_map(i64::to_le_bytes).collect();
+    vtk_array(&mut s, "Int64", "offsets", 1, &offsets);
+    vtk_array(&mut s, "UInt8", "types", 1, &vec![1u8; n]); // VTK_VERTEX
+    s.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    s
+}
+
+/// Node positions, temperatures and spacings read back from a `field_<k>.csv`.
+pub struct FieldRows {
+    /// Positions, m.
+    pub pos: Vec<Point>,
+    /// Temperatures, °C.
+    pub theta: Vec<f64>,
+    /// Spacings Δ, m.
+    pub spacing: Vec<f64>,
+    /// Region index of each node (0 if the file has no such column).
+    pub region: Vec<u32>,
+    /// Damage φ of each node (0 if the file has no such column).
+    pub damage: Vec<f64>,
+    /// Peridynamic heat flux of each node, W/m² (0 if the file has no such columns).
+    pub flux: Vec<Vector>,
+    /// The classical reference at each node, °C, when the file has a `reference` column.
+    pub reference: Option<Vec<f64>>,
+}
+
+/// Reads a `field_<k>.csv` (columns x, y, z, temperature, region, spacing first; damage and
+/// qx, qy, qz when present).
+pub fn read_field(path: &Path) -> Result<FieldRows> {
+    let bad = |m: String| Error::Io {
+        path: path.to_path_buf(),
+        error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+    };
+    let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    // every line of a complete file ends with a newline: a file cut mid-number does not
+    if !text.ends_with('\n') {
+        return Err(bad(
+            "does not end with a newline: the file is cut short".into()
+        ));
+    }
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or("");
+    if !header.starts_with("x,y,z,temperature,region,spacing") {
+        return Err(bad(
+            "not a peritherm field file (header x,y,z,temperature,region,spacing,...)".into(),
+        ));
+    }
+    let mut rows = FieldRows {
+        pos: Vec::new(),
+        theta: Vec::new(),
+        spacing: Vec::new(),
+        region: Vec::new(),
+        damage: Vec::new(),
+        flux: Vec::new(),
+        reference: None,
+    };
+    let reference_column = header.split(',').position(|c| c == "reference");
+    let mut reference = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let v: Vec<f64> = line
+            .split(',')
+            .take(reference_column.map_or(12, |c| c + 1).max(12))
+            .map(str::parse)
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| bad(format!("line {}: {e}", k + 2)))?;
+        if v.len() < 6 {
+            return Err(bad(format!("line {}: fewer than 6 columns", k + 2)));
+        }
+        if let Some(c) = v.iter().position(|x| !x.is_finite()) {
+            return Err(bad(format!(
+                "line {}: column {} is {}, not a finite number",
+                k + 2,
+                c + 1,
+                v[c]
+            )));
+        }
+        rows.pos.push(Point::new(v[0], v[1], v[2]));
+        rows.theta.push(v[3]);
+        rows.spacing.push(v[5]);
+        rows.region.push(v[4] as u32);
+        let extra = |k: usize| v.get(k).copied().unwrap_or(0.0);
+        rows.damage.push(extra(8));
+        rows.flux.push(Vector::new(extra(9), extra(10), extra(11)));
+        if let Some(c) = reference_column {
+            let r = v
+                .get(c)
+                .ok_or_else(|| bad(format!("line {}: no reference value", k + 2)))?;
+            reference.push(*r);
+        }
+    }
+    rows.reference = reference_column.map(|_| reference);
+    if rows.pos.is_empty() {
+        return Err(bad("has a header but no rows".into()));
+    }
+    Ok(rows)
+}
+
+/// Comparison with a classical solution at one output time (theory §9).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Comparison {
+    /// Output time, s.
+    pub time: f64,
+    /// max |θ_c − θ_pd| over the body nodes, °C.
+    pub max_abs_diff: f64,
+    /// Bobaru & Duangpanya 2010, eq. 45: mean of ((θ_c − θ_pd)/θ_c)² over nodes with θ_c ≠ 0.
+    pub mean_sq_rel_diff: f64,
+    /// Bobaru & Duangpanya 2012, eq. 13 along the probe line (all nodes when no line is set).
+    pub l2_rel_line: f64,
+    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
+    /// / max |θ_c|.
+    pub epsilon: f64,
+    /// Relative L2 error over all body nodes compared, weighted by node volume:
+    /// √(Σ V_i (θ_pd − θ_c)² / Σ V_i θ_c²), dimensionless (0 where θ_c ≡ 0).
+    #[serde(default)]
+    pub l2_rel_volume: f64,
+    /// Nodes on the probe line.
+    pub line_nodes: usize,
+    /// The body node nearest to the reference's probe point, if one is set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<Probe>,
+}
+
+/// Temperatures at one node, PD and classical.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Probe {
+    /// Node x, m.
+    pub x: f64,
+    /// Node y, m.
+    pub y: f64,
+    /// Peridynamic temperature, °C.
+    pub peridynamic: f64,
+    /// Classical temperature, °C.
+    pub classical: f64,
+}
+
+/// A file's identity when a run read it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileStamp {
+    /// Absolute path.
+    pub path: String,
+    /// Size, bytes.
+    pub bytes: u64,
+    /// FNV-1a 64-bit hash of the contents, hexadecimal.
+    pub fnv1a: String,
+}
+
+/// The case of a run: where its file was and the files it read.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CaseOrigin {
+    /// Absolute path of the case file (the copy's relative paths resolve against its folder).
+    pub path: String,
+    /// The other files the case read, stamped.
+    pub inputs: Vec<FileStamp>,
+}
+
+/// `run.json` of a run that did not complete.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Unfinished {
+    /// `interrupted` or `failed`.
+    pub status: String,
+    /// Case file.
+    pub case: String,
+    /// Simulated time reached, s.
+    pub time: f64,
+    /// Why it stopped.
+    pub message: String,
+    /// The complete field files it wrote, in output order.
+    pub fields: Vec<String>,
+}
+
+/// Summary written to run.json.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// `complete` (an unfinished run's run.json is a [`Unfinished`]).
+    #[serde(default = "complete")]
+    pub status: String,
+    /// Case title.
+    pub title: String,
+    /// Case file.
+    pub case: String,
+    /// Solver that wrote the run: `peridynamics` or `fem` (run.json files without it:
+    /// peridynamics).
+    #[serde(default = "peridynamics")]
+    pub solver: String,
+    /// Body nodes.
+    pub nodes: usize,
+    /// Fictitious nodes.
+    pub fictitious_nodes: usize,
+    /// Directed bonds (j in H_i, any node i).
+    pub bonds: usize,
+    /// Stored pair conductances (nonzeros of K over body rows).
+    pub pairs: usize,
+    /// Time steps taken.
+    pub steps: u64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Stable bound on the step, s (0 for the FEM solver, whose schemes are unconditionally
+    /// stable).
+    pub dt_stable: f64,
+    /// Integrator.
+    pub integrator: String,
+    /// Output times, s.
+    pub output_times: Vec<f64>,
+    /// Field file names, in output order.
+    pub fields: Vec<String>,
+    /// Total thermal energy Σ V ρc θ of the body at t = 0, J.
+    pub initial_energy: f64,
+    /// Total thermal energy at each output time, J.
+    pub energy: Vec<f64>,
+    /// Seconds to build the model.
+    pub setup_seconds: f64,
+    /// Seconds of time integration, output writing included, the reference comparison not.
+    pub wall_seconds: f64,
+    /// Seconds spent evaluating the classical reference.
+    #[serde(default)]
+    pub reference_seconds: f64,
+    /// Rayon threads used.
+    pub threads: usize,
+    /// Consistent-weights correction: nodes corrected and left out, moment errors before and
+    /// after, iterations, and the range of factors applied to the pair conductances.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub consistency: Option<peritherm_core::weights::Consistency>,
+    /// Comparison with the case's classical reference, per output time.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reference: Vec<Comparison>,
+    /// Implicit runs: solves, factorisations, accepted and rejected steps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub implicit: Option<peritherm_core::solve::implicit::ImplicitStats>,
+    /// The `[history]` samples: their file and, per point, peaks and differences.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<crate::history::HistorySummary>,
+    /// Where the case came from ([`crate::provenance`]); absent in runs written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<CaseOrigin>,
+}
+
+fn peridynamics() -> String {
+    "peridynamics".into()
+}
+
+fn complete() -> String {
+    "complete".into()
+}
+
+impl RunSummary {
+    /// Reads `dir/run.json`.
+    pub fn read(dir: &Path) -> Result<RunSummary> {
+        let path = dir.join("run.json");
+        let text = std::fs::read_to_string(&path).map_err(|error| Error::Io {
+            path: path.clone(),
+            error,
+        })?;
+        let bad = |m: String| Error::Io {
+            path: path.clone(),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        let status = value
+            .get("status")
+            .and_then(|s| s.as_str())
+            .map(str::to_string);
+        if let Some(status) = status {
+            if status != "complete" {
+                let u: Unfinished =
+                    serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+                return Err(bad(format!(
+                    "the run of {} is {status} at t = {:e} s ({}); it has no results to read, run it again",
+                    u.case, u.time, u.message
+                )));
+            }
+        }
+        let summary: RunSummary = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+        summary.check(dir)?;
+        Ok(summary)
+    }
+
+    /// Checks what a reader relies on: one field file per output time, one energy per
+    /// output, finite measures.
+    fn check(&self, dir: &Path) -> Result<()> {
+        let bad = |m: String| Error::Io {
+            path: dir.join("run.json"),
+            error: std::io::Error::new(std::io::ErrorKind::InvalidData, m),
+        };
+        if self.fields.len() != self.output_times.len() {
+            return Err(bad(format!(
+                "lists {} field files for {} output times",
+                self.fields.len(),
+                self.output_times.len()
+            )));
+        }
+        if self.output_times.iter().any(|t| !t.is_finite()) {
+            return Err(bad("an output time is not finite".into()));
+        }
+        let measures = self.reference.iter().flat_map(|c| {
+            [
+                c.max_abs_diff,
+                c.mean_sq_rel_diff,
+                c.l2_rel_line,
+                c.epsilon,
+                c.l2_rel_volume,
+            ]
+        });
+        if measures.into_iter().any(|v| !v.is_finite()) {
+            return Err(bad(
+                "a comparison with the reference is not finite (NaN or infinite)".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads the k-th field (k from 0) of the run in `dir` and checks it is complete: one row
+    /// per body node (`nodes` of run.json), every value finite.
+    pub fn read_field(&self, dir: &Path, k: usize) -> Result<FieldRows> {
+        let path = dir.join(&self.fields[k]);
+        let rows = read_field(&path)?;
+        if rows.pos.len() != self.nodes {
+            return Err(Error::Io {
+                path,
+                error: std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!(
+                        "has {} rows but run.json says {} nodes: the file is incomplete or from another run",
+                        rows.pos.len(),
+                        self.nodes
+                    ),
+                ),
+            });
+        }
+        Ok(rows)
+    }
+
+    /// Markdown rows (one per output time) comparing this run with its reference.
+    pub fn table_rows(&self) -> Vec<String> {
+        let name = Path::new(&self.case)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        self.reference
+            .iter()
+            .map(|c| {
+                let probe = c
+                    .probe
+                    .as_ref()
+                    .map(|p| format!("{:.3} / {:.3}", p.peridynamic, p.classical))
+                    .unwrap_or_else(|| "-".into());
+                format!(
+                    "| {name} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {probe} | {} | {} | {:.1} |",
+                    number_label(c.time),
+                    self.nodes,
+                    c.max_abs_diff,
+                    c.mean_sq_rel_diff,
+                    c.l2_rel_line,
+                    self.bonds,
+                    self.steps,
+                    self.wall_seconds
+                )
+            })
+            .collect()
+    }
+
+    /// Header of [`RunSummary::table_rows`].
+    pub fn table_header() -> &'static str {
+        "| case | t (s) | nodes | max abs diff (°C) | eq 45 | eq 13 | probe PD / classical (°C) | bonds | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|"
+    }
+
+    /// Writes run.json atomically.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let json = serde_json::to_string_pretty(self).expect("plain data serialises");
+        write_atomic(&dir.join("run.json"), json.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::base64;
+
+    /// RFC 4648 test vectors.
+    #[test]
+    fn base64_vectors() {
+        for (raw, enc) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            let mut s = String::new();
+            base64(raw.as_bytes(), &mut s);
+            assert_eq!(s, enc);
+        }
+    }
+}
