@@ -140,6 +140,8 @@ fn execute(
     let mut recorder = recorder(case, model, reference.as_ref(), &theta);
     let mut on_output =
         |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
+            // an interrupted run reports at least the last output it wrote
+            reached(t);
             if let Some(r) = recorder.as_mut() {
                 r.record(t, th);
             }
