@@ -37,6 +37,7 @@ pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod run;
+pub mod simulation;
 pub mod solve;
 pub mod spatial;
 pub mod staging;

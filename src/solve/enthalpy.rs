@@ -181,7 +181,7 @@ impl<'a> Enthalpic<'a> {
     }
 
     /// K with the current conductivities, K_ij = λ̄_ij K_ij(λ = 1), W/K.
-    fn scale_conductance(&mut self) {
+    pub(crate) fn scale_conductance(&mut self) {
         let k = &self.model.conductance;
         let rule = self.model.bond_rule;
         for i in 0..k.n_rows() {
@@ -194,6 +194,16 @@ impl<'a> Enthalpic<'a> {
             }
             self.scaled.diag[i] = d;
         }
+    }
+
+    /// K as last set by `scale_conductance`, W/K.
+    pub(crate) fn scaled(&self) -> &Conductance {
+        &self.scaled
+    }
+
+    /// Makes the next step take the enthalpies from the temperature field again.
+    pub(crate) fn restart(&mut self) {
+        self.ready = false;
     }
 
     /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K, E)` there

@@ -299,7 +299,7 @@ impl<'a> Explicit<'a> {
     }
 
     /// Cuts, in place, the pairs whose growing-crack cut time has come by `t`.
-    fn cut_until(&mut self, t: f64) {
+    pub(crate) fn cut_until(&mut self, t: f64) {
         let cuts = &self.model.growth;
         while self.next_cut < cuts.len() && cuts[self.next_cut].time <= t {
             let c = cuts[self.next_cut];
