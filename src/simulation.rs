@@ -243,12 +243,18 @@ impl<'a> Simulation<'a> {
     /// W/K.
     pub fn conductance(&mut self) -> &Conductance {
         match &mut self.engine {
-            Engine::Explicit(e) => e.conductance(),
-            Engine::Enthalpic(e) if self.started => {
+            Engine::Explicit(e) => {
+                e.cut_until(self.t);
+                e.conductance()
+            }
+            Engine::Enthalpic(e) => {
+                // the conductivities need the enthalpies: set them now as the first step would
+                e.prime(&mut self.theta, self.t);
+                self.started = true;
                 e.scale_conductance();
                 e.scaled()
             }
-            _ => &self.model.conductance,
+            Engine::Implicit(_) => &self.model.conductance,
         }
     }
 

@@ -201,6 +201,13 @@ impl<'a> Enthalpic<'a> {
         &self.scaled
     }
 
+    /// Takes the enthalpies from `theta` at `t` now unless they were (as the first step would).
+    pub(crate) fn prime(&mut self, theta: &mut [f64], t: f64) {
+        if !self.ready {
+            self.start(theta, t);
+        }
+    }
+
     /// Makes the next step take the enthalpies from the temperature field again.
     pub(crate) fn restart(&mut self) {
         self.ready = false;
