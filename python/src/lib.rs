@@ -158,6 +158,55 @@ fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
     )))
 }
 
+/// A parse error of the TOML made from a dict names a line of that text, which the user never
+/// saw: name the dotted key written on that line instead (`region[1].spacing`).
+fn keyed_by_line(e: peritherm::Error, text: &str) -> peritherm::Error {
+    let peritherm::Error::Case { file, key, message } = e else {
+        return e;
+    };
+    let Some(line) = key
+        .strip_prefix("line ")
+        .and_then(|n| n.parse::<usize>().ok())
+    else {
+        return peritherm::Error::Case { file, key, message };
+    };
+    let mut table = String::new();
+    let mut counts: std::collections::HashMap<String, usize> = Default::default();
+    let mut found = None;
+    for (i, l) in text.lines().enumerate().take(line) {
+        let l = l.trim();
+        if let Some(h) = l.strip_prefix("[[").and_then(|h| h.strip_suffix("]]")) {
+            let n = counts.entry(h.to_string()).or_insert(0);
+            table = format!("{h}[{n}]");
+            *n += 1;
+        } else if let Some(h) = l.strip_prefix('[').and_then(|h| h.strip_suffix(']')) {
+            // a sub-table of the last item of an array of tables: `[region.horizon]`
+            table = match counts.keys().find(|a| h.starts_with(&format!("{a}."))) {
+                Some(a) => format!("{a}[{}]{}", counts[a] - 1, &h[a.len()..]),
+                None => h.to_string(),
+            };
+        }
+        if i + 1 == line {
+            found = Some(match l.split_once('=') {
+                Some((k, _)) if !l.starts_with('[') => {
+                    let k = k.trim().trim_matches('"');
+                    if table.is_empty() {
+                        k.to_string()
+                    } else {
+                        format!("{table}.{k}")
+                    }
+                }
+                _ => table.clone(),
+            });
+        }
+    }
+    peritherm::Error::Case {
+        file,
+        key: found.filter(|k| !k.is_empty()).unwrap_or(key),
+        message,
+    }
+}
+
 /// A path argument: `str` or `os.PathLike`.
 fn path_arg(p: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
     p.extract::<PathBuf>()
@@ -208,7 +257,7 @@ impl PyCase {
             Some(p) => path_arg(p)?,
             None => PathBuf::from("<dict>"),
         };
-        let case = Case::parse(&text, &path).map_err(py_err)?;
+        let case = Case::parse(&text, &path).map_err(|e| py_err(keyed_by_line(e, &text)))?;
         Ok(PyCase {
             case: Arc::new(case),
         })
