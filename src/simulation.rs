@@ -23,7 +23,7 @@ pub const CHECK_EVERY: u64 = 64;
 enum Engine<'a> {
     Explicit(Explicit<'a>),
     Enthalpic(Enthalpic<'a>),
-    Implicit(Implicit<'a>),
+    Implicit(Box<Implicit<'a>>),
 }
 
 /// The fields at one output time of [`Simulation::run`].
@@ -62,7 +62,7 @@ impl<'a> Simulation<'a> {
         let plan = plan(case, model)?;
         let engine = match (plan.enthalpic, plan.implicit) {
             (Some(e), _) => Engine::Enthalpic(e),
-            (None, Some(i)) => Engine::Implicit(i),
+            (None, Some(i)) => Engine::Implicit(Box::new(i)),
             (None, None) => Engine::Explicit(Explicit::new(model, case.integrator)),
         };
         Ok(Simulation {
@@ -215,10 +215,10 @@ impl<'a> Simulation<'a> {
             done += 1;
             self.steps += 1;
             self.t = t1;
-            if self.steps % 4096 == 0 && !matches!(self.engine, Engine::Implicit(_)) {
+            if self.steps.is_multiple_of(4096) && !matches!(self.engine, Engine::Implicit(_)) {
                 check_finite(&self.theta, nb, self.t)?;
             }
-            if done < n && done % CHECK_EVERY == 0 && !keep_going(self.steps) {
+            if done < n && done.is_multiple_of(CHECK_EVERY) && !keep_going(self.steps) {
                 stopped = true;
                 break;
             }
