@@ -6,6 +6,7 @@
 use numpy::{PyArray1, PyArray2};
 use peritherm::case::Case;
 use peritherm::fem::{run_fem, FemOptions, Scheme};
+use peritherm::history::output_index;
 use peritherm::model::Model;
 use peritherm::output::RunSummary;
 use peritherm::simulation::{Simulation, Snapshot};
@@ -588,7 +589,7 @@ impl PyModel {
     }
 
     /// Advances through `outputs` (s; default: the case's output times after the current
-    /// time) and returns, per output, a dict of `time`, `temperature` (n_body,), `flux`
+    /// time, the steps also landing on its `[history]` sample times as a run's do) and returns, per output, a dict of `time`, `temperature` (n_body,), `flux`
     /// (n_body, 3), `damage` (n_body,) and `energy`; the outputs are also recorded for
     /// `write`. From t = 0 with the case's outputs this is `peritherm run` bit for bit.
     #[pyo3(signature = (outputs = None))]
@@ -596,17 +597,21 @@ impl PyModel {
         let mut guard = self.state()?;
         let state = &mut *guard;
         let t0 = state.sim.time();
-        let outputs = outputs.unwrap_or_else(|| {
-            self.case
-                .outputs
-                .iter()
-                .copied()
-                .filter(|&t| t > t0)
-                .collect()
-        });
+        // by default the case's stops, as a run makes them: the outputs and the `[history]`
+        // samples (the steps land on both), of which the outputs are returned
+        let (stops, from_case) = match outputs {
+            Some(o) => (o, false),
+            None => (
+                self.case.times().into_iter().filter(|&t| t > t0).collect(),
+                true,
+            ),
+        };
         let mut signals = Signals::new();
-        let result = py.detach(|| state.sim.run(&outputs, |_| signals.keep_going()));
-        let (snapshots, _) = result.map_err(py_err)?;
+        let result = py.detach(|| state.sim.run(&stops, |_| signals.keep_going()));
+        let (mut snapshots, _) = result.map_err(py_err)?;
+        if from_case {
+            snapshots.retain(|s| output_index(&self.case.outputs, s.time).is_some());
+        }
         let out = PyList::empty(py);
         for s in &snapshots {
             out.append(snapshot_dict(py, s, self.model.cloud.n_body)?)?;

@@ -73,6 +73,15 @@ def small_case(kind: str) -> dict:
         d["region"][0]["spacing"] = 0.02
         d["time"] = {"end": 43200.0, "outputs": [21600.0, 43200.0]}
         return d
+    if kind == "history":
+        # RK4 with a source; the history's samples (every 7e-15 s, not a multiple of dt)
+        # are stops of the run too
+        d = bundled("laser_film")
+        d["region"][0]["spacing"] = 1e-9
+        d["time"]["end"] = 5e-13
+        d["time"]["outputs"] = [2e-13, 5e-13]
+        d["history"]["interval"] = 7e-15
+        return d
     if kind == "growing":
         d = bundled("growing_cracks")
         d["region"][0]["cells"] = [40, 40]

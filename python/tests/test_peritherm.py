@@ -14,7 +14,17 @@ import pytest
 import peritherm
 from conftest import ROOT, read_csv, run_cli, small_case, write_case
 
-KINDS = ["euler", "rk4", "crank_nicolson", "bdf2", "adaptive", "steady", "enthalpy", "growing"]
+KINDS = [
+    "euler",
+    "rk4",
+    "crank_nicolson",
+    "bdf2",
+    "adaptive",
+    "steady",
+    "enthalpy",
+    "growing",
+    "history",
+]
 COLUMNS = ["temperature", "damage", "qx", "qy", "qz"]
 
 
