@@ -251,6 +251,22 @@ def test_ctrl_c_interrupts_stepping():
     m.step(1)  # still usable
 
 
+def test_ctrl_c_interrupts_run_case_and_leaves_out_as_it_was(tmp_path):
+    """SIGINT during run_case raises KeyboardInterrupt; no output directory and no staged
+    copy are left behind."""
+    d = small_case("euler")
+    del d["reference"]
+    d["time"] = {"end": 1e4, "outputs": [1e4]}  # about 1e6 steps: minutes
+    path = write_case(d, tmp_path / "long.toml", peritherm)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    started = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        peritherm.run_case(path, tmp_path / "out")
+    assert time.monotonic() - started < 30
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["long.toml"]
+
+
 def test_dict_and_file_give_the_same_case():
     path = ROOT / "cases" / "dh_crack_plate_k2_m1.toml"
     import tomllib
