@@ -30,6 +30,7 @@ pub mod bench;
 pub mod fem;
 pub mod prepare;
 pub mod run;
+pub mod simulation;
 pub mod sweep;
 
 pub use error::{Error, Result};

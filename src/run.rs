@@ -74,67 +74,15 @@ fn execute(
     let origin = crate::provenance::write_copy(out, case)?;
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
-    let mut energy = Vec::new();
-    let mut fields = Vec::new();
-    let mut comparisons = Vec::new();
-    let mut reference_seconds = 0.0;
     let t_run = Instant::now();
-    let cutters = crack_cutters(&model.cloud, &case.spec.cracks);
     let started = Instant::now();
-    let reference = resolve_reference(case, out)?;
+    let mut writer = OutputWriter::new(case, model, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
-    let mut on_output = |k: usize,
-                         t: f64,
-                         th: &[f64],
-                         conductance: &crate::operator::Conductance,
-                         e: f64| {
-        energy.push(e);
-        let path = field_path(out, k + 1);
-        let flux = conductance.flux(&model.cloud, th);
-        let damage = model.damage_at(t);
-        let classical = match &reference {
-            Some(r) => {
-                let started = Instant::now();
-                let classical = classical_at(&model.cloud, &r.source, t, &cutters)?;
-                let tips = tips_at(&cutters, t);
-                let c = compare(&model.cloud, th, &classical, r, t, &tips);
-                let measures = [c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line, c.epsilon];
-                if measures.iter().any(|v| !v.is_finite()) {
-                    // finite values whose squares overflow: never an exact match
-                    return Err(Error::Case {
-                            file: case.path.clone(),
-                            key: "reference".into(),
-                            message: format!(
-                                "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
-                                c.max_abs_diff
-                            ),
-                        });
-                }
-                comparisons.push(c);
-                reference_seconds += started.elapsed().as_secs_f64();
-                Some(classical)
-            }
-            None => None,
+    let reference = writer.reference.clone();
+    let mut on_output =
+        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
+            writer.write(k, t, th, conductance, e)
         };
-        let f = Fields {
-            theta: th,
-            damage: &damage,
-            flux: &flux,
-            reference: classical.as_deref(),
-        };
-        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-        write_atomic(
-            &vtu_path(out, k + 1),
-            field_vtu(&model.cloud, &f).as_bytes(),
-        )?;
-        fields.push(
-            path.file_name()
-                .expect("file")
-                .to_string_lossy()
-                .into_owned(),
-        );
-        Ok(())
-    };
     // the steppers stop at the outputs and at the history's samples
     let times = case.times();
     let mut recorder = recorder(case, model, reference.as_ref(), &theta);
@@ -235,21 +183,129 @@ fn execute(
         },
         integrator: case.integrator.name().into(),
         output_times: case.outputs.clone(),
-        fields,
+        fields: writer.fields,
         initial_energy,
-        energy,
+        energy: writer.energy,
         setup_seconds,
-        wall_seconds: t_run.elapsed().as_secs_f64() - reference_seconds - fem_seconds,
-        reference_seconds: reference_seconds + fem_seconds,
+        wall_seconds: t_run.elapsed().as_secs_f64() - writer.reference_seconds - fem_seconds,
+        reference_seconds: writer.reference_seconds + fem_seconds,
         threads: rayon::current_num_threads(),
         consistency: model.correction,
-        reference: comparisons,
+        reference: writer.comparisons,
         implicit: implicit.as_ref().map(|st| st.stats),
         history,
         origin: Some(origin),
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// What a run writes at each output time into its (staged) directory: `field_<k>.csv` and
+/// `field_<k>.vtu` with the flux, the damage and the case's reference, and the comparison
+/// with that reference; it keeps what run.json lists.
+pub struct OutputWriter<'a> {
+    case: &'a Case,
+    model: &'a Model,
+    out: &'a Path,
+    cutters: Vec<crate::crack::Cutter>,
+    /// The case's reference, resolved ([`resolve_reference`]).
+    pub reference: Option<ReferenceSpec>,
+    /// Energy of the body at each output written, J.
+    pub energy: Vec<f64>,
+    /// Field files written (`field_<k>.csv`, names only).
+    pub fields: Vec<String>,
+    /// Comparisons with the reference, one per output written.
+    pub comparisons: Vec<crate::output::Comparison>,
+    /// Time spent evaluating and comparing with the reference, s.
+    pub reference_seconds: f64,
+}
+
+impl<'a> OutputWriter<'a> {
+    /// Resolves the case's reference (a `[reference.fem]` is solved into `out/fem/`).
+    pub fn new(case: &'a Case, model: &'a Model, out: &'a Path) -> Result<Self> {
+        Ok(OutputWriter {
+            case,
+            model,
+            out,
+            cutters: crack_cutters(&model.cloud, &case.spec.cracks),
+            reference: resolve_reference(case, out)?,
+            energy: Vec::new(),
+            fields: Vec::new(),
+            comparisons: Vec::new(),
+            reference_seconds: 0.0,
+        })
+    }
+
+    /// Writes output `k` (from 0) at time `t` (s): temperature `th` of every node (°C), the
+    /// flux through `conductance` (W/K) and the body's energy `e` (J).
+    pub fn write(
+        &mut self,
+        k: usize,
+        t: f64,
+        th: &[f64],
+        conductance: &crate::operator::Conductance,
+        e: f64,
+    ) -> Result<()> {
+        let flux = conductance.flux(&self.model.cloud, th);
+        self.write_with_flux(k, t, th, &flux, e)
+    }
+
+    /// [`OutputWriter::write`] with the heat flux of every body node given, W/m².
+    pub fn write_with_flux(
+        &mut self,
+        k: usize,
+        t: f64,
+        th: &[f64],
+        flux: &[crate::math::Vector],
+        e: f64,
+    ) -> Result<()> {
+        let (case, model, out) = (self.case, self.model, self.out);
+        self.energy.push(e);
+        let path = field_path(out, k + 1);
+        let damage = model.damage_at(t);
+        let classical = match &self.reference {
+            Some(r) => {
+                let started = Instant::now();
+                let classical = classical_at(&model.cloud, &r.source, t, &self.cutters)?;
+                let tips = tips_at(&self.cutters, t);
+                let c = compare(&model.cloud, th, &classical, r, t, &tips);
+                let measures = [c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line, c.epsilon];
+                if measures.iter().any(|v| !v.is_finite()) {
+                    // finite values whose squares overflow: never an exact match
+                    return Err(Error::Case {
+                            file: case.path.clone(),
+                            key: "reference".into(),
+                            message: format!(
+                                "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
+                                c.max_abs_diff
+                            ),
+                        });
+                }
+                self.comparisons.push(c);
+                self.reference_seconds += started.elapsed().as_secs_f64();
+                Some(classical)
+            }
+            None => None,
+        };
+        let f = Fields {
+            theta: th,
+            damage: &damage,
+            flux,
+            reference: classical.as_deref(),
+        };
+        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic(
+            &vtu_path(out, k + 1),
+            field_vtu(&model.cloud, &f).as_bytes(),
+        )?;
+        self.fields.push(
+            path.file_name()
+                .expect("file")
+                .to_string_lossy()
+                .into_owned(),
+        );
+        Ok(())
+    }
 }
 
 /// The recorder of the case's `[history]` (None without one), with the analytical reference

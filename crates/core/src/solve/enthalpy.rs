@@ -181,7 +181,7 @@ impl<'a> Enthalpic<'a> {
     }
 
     /// K with the current conductivities, K_ij = λ̄_ij K_ij(λ = 1), W/K.
-    fn scale_conductance(&mut self) {
+    pub fn scale_conductance(&mut self) {
         let k = &self.model.conductance;
         let rule = self.model.bond_rule;
         for i in 0..k.n_rows() {
@@ -194,6 +194,23 @@ impl<'a> Enthalpic<'a> {
             }
             self.scaled.diag[i] = d;
         }
+    }
+
+    /// K as last set by `scale_conductance`, W/K.
+    pub fn scaled(&self) -> &Conductance {
+        &self.scaled
+    }
+
+    /// Takes the enthalpies from `theta` at `t` now unless they were (as the first step would).
+    pub fn prime(&mut self, theta: &mut [f64], t: f64) {
+        if !self.ready {
+            self.start(theta, t);
+        }
+    }
+
+    /// Makes the next step take the enthalpies from the temperature field again.
+    pub fn restart(&mut self) {
+        self.ready = false;
     }
 
     /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K, E)` there

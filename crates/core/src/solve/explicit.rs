@@ -299,7 +299,7 @@ impl<'a> Explicit<'a> {
     }
 
     /// Cuts, in place, the pairs whose growing-crack cut time has come by `t`.
-    fn cut_until(&mut self, t: f64) {
+    pub fn cut_until(&mut self, t: f64) {
         let cuts = &self.model.growth;
         while self.next_cut < cuts.len() && cuts[self.next_cut].time <= t {
             let c = cuts[self.next_cut];
@@ -475,7 +475,8 @@ fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
         });
 }
 
-pub(crate) fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
+/// Fails with [`Error::NonFinite`] at the first body node of `theta` (of `nb`) that is not finite at time `t`, s.
+pub fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
     match theta[..nb].iter().position(|v| !v.is_finite()) {
         Some(node) => Err(Error::NonFinite { node, time: t }),
         None => Ok(()),

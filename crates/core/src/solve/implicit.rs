@@ -582,6 +582,10 @@ pub struct Implicit<'a> {
     min_mass: f64,
     /// Counters and timings.
     pub stats: ImplicitStats,
+    /// Fixed steps taken since [`Implicit::start`] (0: the next is a start-up step).
+    taken: u64,
+    /// Length of the last fixed step, s.
+    h_prev: f64,
 }
 
 impl<'a> Implicit<'a> {
@@ -681,6 +685,8 @@ impl<'a> Implicit<'a> {
             min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,
             sys,
+            taken: 0,
+            h_prev: 0.0,
         })
     }
 
@@ -987,6 +993,55 @@ impl<'a> Implicit<'a> {
         }
     }
 
+    /// Starts fixed-step stepping ([`Implicit::step`]) from `theta` (every node, °C) at
+    /// `t0`, s: the unknowns and the forcing are taken there, and the next step is a start-up
+    /// step (Crank–Nicolson: two backward-Euler half steps; BDF2: backward Euler).
+    pub fn start(&mut self, theta: &[f64], t0: f64) {
+        self.gather(theta);
+        self.sys.forcing(
+            self.model,
+            t0,
+            &mut self.scratch,
+            &mut self.rate,
+            &mut self.f_now,
+        );
+        self.taken = 0;
+        self.h_prev = 0.0;
+    }
+
+    /// One fixed step of length `h` (s) from `tn` to `t1` (s; `t1` is `tn + h` up to the
+    /// round-off the caller chooses, e.g. exactly an output time), after [`Implicit::start`].
+    /// The state stays in the unknowns until [`Implicit::state_into`].
+    pub fn step(&mut self, tn: f64, t1: f64, h: f64) -> Result<()> {
+        match self.scheme {
+            Scheme::BackwardEuler => self.be_step(t1, h)?,
+            Scheme::CrankNicolson if self.taken == 0 => {
+                // Rannacher start-up: two BE half steps, the matrix of CN
+                self.be_step(tn + 0.5 * h, 0.5 * h)?;
+                self.be_step(t1, 0.5 * h)?;
+                std::mem::swap(&mut self.f_now, &mut self.f_next);
+            }
+            Scheme::CrankNicolson => self.cn_step(t1, h)?,
+            Scheme::Bdf2 if self.taken == 0 => self.be_step(t1, h)?,
+            Scheme::Bdf2 => self.bdf2_step(t1, h, h / self.h_prev)?,
+        }
+        self.h_prev = h;
+        self.taken += 1;
+        if self.taken == 1 {
+            self.stats.first_step = h;
+            self.stats.min_step = h;
+        }
+        self.stats.min_step = self.stats.min_step.min(h);
+        self.stats.max_step = self.stats.max_step.max(h);
+        Ok(())
+    }
+
+    /// Writes the state of the fixed steps into `theta` (every node, °C) with the constrained
+    /// nodes set at time `t`, s; an error if a body temperature is not finite.
+    pub fn state_into(&self, theta: &mut [f64], t: f64) -> Result<()> {
+        self.scatter(theta, t)
+    }
+
     /// Integrates from `t0` through each output time with steps no longer than `dt` that land
     /// on the output times, calling `on_output(k, t, θ, K)` there (θ: every node) and
     /// `progress(steps)` after every step.
@@ -1005,17 +1060,9 @@ impl<'a> Implicit<'a> {
                 format!("must be a positive number for an implicit integrator, got {dt}"),
             ));
         }
-        self.gather(theta);
+        self.start(theta, t0);
         let mut stats = RunStats::default();
         let mut t = t0;
-        let mut h_prev = 0.0;
-        self.sys.forcing(
-            self.model,
-            t0,
-            &mut self.scratch,
-            &mut self.rate,
-            &mut self.f_now,
-        );
         for (k, &to) in outputs.iter().enumerate() {
             let n = steps_between(t, to, dt);
             let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
@@ -1025,27 +1072,8 @@ impl<'a> Implicit<'a> {
                 } else {
                     t + (s + 1) as f64 * h
                 };
-                let tn = t + s as f64 * h;
-                match self.scheme {
-                    Scheme::BackwardEuler => self.be_step(t1, h)?,
-                    Scheme::CrankNicolson if stats.steps == 0 => {
-                        // Rannacher start-up: two BE half steps, the matrix of CN
-                        self.be_step(tn + 0.5 * h, 0.5 * h)?;
-                        self.be_step(t1, 0.5 * h)?;
-                        std::mem::swap(&mut self.f_now, &mut self.f_next);
-                    }
-                    Scheme::CrankNicolson => self.cn_step(t1, h)?,
-                    Scheme::Bdf2 if stats.steps == 0 => self.be_step(t1, h)?,
-                    Scheme::Bdf2 => self.bdf2_step(t1, h, h / h_prev)?,
-                }
-                h_prev = h;
+                self.step(t + s as f64 * h, t1, h)?;
                 stats.steps += 1;
-                if stats.steps == 1 {
-                    self.stats.first_step = h;
-                    self.stats.min_step = h;
-                }
-                self.stats.min_step = self.stats.min_step.min(h);
-                self.stats.max_step = self.stats.max_step.max(h);
                 progress(stats.steps);
             }
             t = to;
