@@ -36,17 +36,8 @@ pub struct Plan<'a> {
 /// A library error keyed to the case file.
 pub fn keyed(case: &Case, e: Error) -> Error {
     match e {
-        Error::Model { key, message } => Error::Case {
-            file: case.path.clone(),
-            key,
-            message,
-        },
-        Error::UnstableDt { .. } => Error::Case {
-            file: case.path.clone(),
-            key: "time.dt".into(),
-            message: e.to_string(),
-        },
-        other => other,
+        Error::UnstableDt { .. } => case.error("time.dt", e.to_string()),
+        other => case.keyed(other),
     }
 }
 
@@ -54,11 +45,7 @@ pub fn keyed(case: &Case, e: Error) -> Error {
 pub fn build(case: &Case, options: &Options) -> Result<Model> {
     case.budget
         .enforce(options.max_memory)
-        .map_err(|message| Error::Case {
-            file: case.path.clone(),
-            key: case.budget.key.clone(),
-            message,
-        })?;
+        .map_err(|message| case.error(&case.budget.key, message))?;
     let model = Model::build(&case.spec).map_err(|e| keyed(case, e))?;
     semantic(case, &model).map_err(|e| keyed(case, e))?;
     Ok(model)
@@ -165,13 +152,12 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
                     ),
                 ),
             };
-            return Err(Error::Case {
-                file: case.path.clone(),
-                key: key.into(),
-                message: format!(
+            return Err(case.error(
+                key,
+                format!(
                     "{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"
                 ),
-            });
+            ));
         }
         count_steps(0.0, &case.times(), dt)
     } else {

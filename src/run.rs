@@ -144,14 +144,13 @@ fn execute(
     let stats = result.map_err(|e| match e {
         Error::NonFinite { node, time } => {
             let p = model.cloud.pos[node];
-            Error::Case {
-                file: case.path.clone(),
-                key: likely_cause(case, model, node, time),
-                message: format!(
+            case.error(
+                likely_cause(case, model, node, time),
+                format!(
                     "temperature became non-finite near ({}, {}, {}) by t = {time:e} s; this key most likely caused it (else check the source, boundary values and time.dt)",
                     p.x, p.y, p.z
                 ),
-            }
+            )
         }
         other => keyed(case, other),
     })?;
@@ -272,14 +271,13 @@ impl<'a> OutputWriter<'a> {
                 let measures = [c.max_abs_diff, c.mean_sq_rel_diff, c.l2_rel_line, c.epsilon];
                 if measures.iter().any(|v| !v.is_finite()) {
                     // finite values whose squares overflow: never an exact match
-                    return Err(Error::Case {
-                            file: case.path.clone(),
-                            key: "reference".into(),
-                            message: format!(
-                                "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
-                                c.max_abs_diff
-                            ),
-                        });
+                    return Err(case.error(
+                        "reference",
+                        format!(
+                            "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
+                            c.max_abs_diff
+                        ),
+                    ));
                 }
                 self.comparisons.push(c);
                 self.reference_seconds += started.elapsed().as_secs_f64();

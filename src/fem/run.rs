@@ -45,19 +45,14 @@ pub fn model_with(case: &Case, opts: &FemOptions) -> Result<FemModel> {
     FemModel::build(&problem(case, opts))
 }
 
+/// A library error keyed to the case file (a non-finite state to the key `state`).
 fn keyed(case: &Case, e: Error) -> Error {
     match e {
-        Error::Model { key, message } => Error::Case {
-            file: case.path.clone(),
-            key,
-            message,
-        },
-        Error::NonFinite { time, .. } => Error::Case {
-            file: case.path.clone(),
-            key: "state".into(),
-            message: format!("fem: temperature became non-finite by t = {time:e} s; check source and boundary values"),
-        },
-        other => other,
+        Error::NonFinite { time, .. } => case.error(
+            "state",
+            format!("fem: temperature became non-finite by t = {time:e} s; check source and boundary values"),
+        ),
+        other => case.keyed(other),
     }
 }
 

@@ -9,6 +9,10 @@ pub type Point = nalgebra::Point3<Real>;
 /// A difference of positions (bond vector ξ), same unit as [`Point`].
 pub type Vector = nalgebra::Vector3<Real>;
 
+/// Relative tolerance of geometric coincidence (breakpoints, region extents, crack ends), as a
+/// fraction of the domain's size: two coordinates closer than this are the same.
+pub const GEOMETRIC_TOLERANCE: Real = 1e-9;
+
 /// Index of a node in a cloud; u32 keeps neighbour lists compact.
 pub type NodeId = u32;
 

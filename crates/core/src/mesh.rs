@@ -44,6 +44,25 @@ impl ElementKind {
             ElementKind::Hex => 8,
         }
     }
+
+    /// Local node indices of each facet (face of dimension d − 1), gmsh ordering.
+    pub fn facets(self) -> &'static [&'static [usize]] {
+        match self {
+            ElementKind::Point => &[],
+            ElementKind::Line => &[&[0], &[1]],
+            ElementKind::Triangle => &[&[0, 1], &[1, 2], &[2, 0]],
+            ElementKind::Quad => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
+            ElementKind::Tet => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]],
+            ElementKind::Hex => &[
+                &[0, 3, 2, 1],
+                &[0, 1, 5, 4],
+                &[0, 4, 7, 3],
+                &[1, 2, 6, 5],
+                &[2, 3, 7, 6],
+                &[4, 5, 6, 7],
+            ],
+        }
+    }
 }
 
 /// A named physical group (gmsh `Physical Curve("name")` and the like).

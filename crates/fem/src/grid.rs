@@ -10,12 +10,9 @@ use crate::mesh::{Cell, FemMesh};
 use crate::shape::MAX_NODES;
 use peritherm_core::cloud::BoxGeometry;
 use peritherm_core::error::{Error, Result};
-use peritherm_core::math::Point;
+use peritherm_core::math::{Point, GEOMETRIC_TOLERANCE};
 use peritherm_core::mesh::ElementKind;
 use peritherm_core::model::{Crack, CrackShape};
-
-/// Relative tolerance for breakpoints that coincide, of the domain's largest side.
-const REL: f64 = 1e-9;
 
 /// Grid lines along one axis from `[lo, hi]` with breakpoints `cuts`, cells no longer than `h`, m.
 fn axis_lines(lo: f64, hi: f64, cuts: &[f64], h: f64, eps: f64) -> Vec<f64> {
@@ -81,7 +78,7 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
     g.validate()?;
     let dim = g.dim;
     let scale = (0..dim).map(|a| g.max[a] - g.min[a]).fold(0.0, f64::max);
-    let eps = REL * scale;
+    let eps = GEOMETRIC_TOLERANCE * scale;
     if !(h.is_finite() && h > 0.0) {
         return Err(Error::model(
             "h",

@@ -168,23 +168,9 @@ pub fn shape(kind: ElementKind, xi: [f64; 3]) -> ShapeAt {
     s
 }
 
-/// Local node indices of each facet (face of dimension d − 1) of an element, gmsh ordering.
+/// Local node indices of each facet of an element, gmsh ordering ([`ElementKind::facets`]).
 pub fn facets(kind: ElementKind) -> &'static [&'static [usize]] {
-    match kind {
-        ElementKind::Point => &[],
-        ElementKind::Line => &[&[0], &[1]],
-        ElementKind::Triangle => &[&[0, 1], &[1, 2], &[2, 0]],
-        ElementKind::Quad => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
-        ElementKind::Tet => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]],
-        ElementKind::Hex => &[
-            &[0, 3, 2, 1],
-            &[0, 1, 5, 4],
-            &[0, 4, 7, 3],
-            &[1, 2, 6, 5],
-            &[2, 3, 7, 6],
-            &[4, 5, 6, 7],
-        ],
-    }
+    kind.facets()
 }
 
 /// The element kind of a facet with `n` corners in a body of dimension `dim`.

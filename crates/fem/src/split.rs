@@ -10,12 +10,9 @@
 use crate::mesh::{key_of, FacetKey, FemMesh};
 use crate::shape::facets;
 use peritherm_core::error::{Error, Result};
-use peritherm_core::math::Point;
+use peritherm_core::math::{Point, GEOMETRIC_TOLERANCE};
 use peritherm_core::model::{Crack, CrackShape};
 use std::collections::{HashMap, HashSet};
-
-/// Relative tolerance (of the mesh's largest extent) for a node lying on a crack segment.
-const REL: f64 = 1e-9;
 
 fn on_segment(p: &Point, a: &Point, b: &Point, eps: f64) -> bool {
     let ab = b - a;
@@ -36,7 +33,7 @@ fn polyline_facets(
     pts: &[Point],
 ) -> Result<Vec<FacetKey>> {
     let (lo, hi) = bounds(mesh);
-    let eps = REL * (hi - lo).norm();
+    let eps = GEOMETRIC_TOLERANCE * (hi - lo).norm();
     let mut out = Vec::new();
     let mut covered = 0.0;
     for (key, refs) in map {

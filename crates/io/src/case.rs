@@ -505,6 +505,24 @@ pub struct Case {
 }
 
 impl Case {
+    /// An error about `key` (dotted, e.g. `time.dt`) of this case file.
+    pub fn error(&self, key: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::Case {
+            file: self.path.clone(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A library error keyed to this case file: a model error's key becomes a key of the
+    /// file; every other error is returned as it is.
+    pub fn keyed(&self, e: Error) -> Error {
+        match e {
+            Error::Model { key, message } => self.error(key, message),
+            other => other,
+        }
+    }
+
     /// The times the run stops at, s: the outputs and the history's samples up to the last
     /// output, increasing.
     pub fn times(&self) -> Vec<f64> {

@@ -44,25 +44,6 @@ pub struct MeshGeometry {
     pub horizon_ratio: Option<f64>,
 }
 
-/// Corner indices of each face of an element (gmsh node ordering).
-fn faces_of(kind: ElementKind) -> &'static [&'static [usize]] {
-    match kind {
-        ElementKind::Point => &[],
-        ElementKind::Line => &[&[0], &[1]],
-        ElementKind::Triangle => &[&[0, 1], &[1, 2], &[2, 0]],
-        ElementKind::Quad => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
-        ElementKind::Tet => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]],
-        ElementKind::Hex => &[
-            &[0, 3, 2, 1],
-            &[0, 1, 5, 4],
-            &[0, 4, 7, 3],
-            &[1, 2, 6, 5],
-            &[2, 3, 7, 6],
-            &[4, 5, 6, 7],
-        ],
-    }
-}
-
 type FaceKey = [u32; 4];
 
 fn key_of(nodes: &[u32]) -> FaceKey {
@@ -246,7 +227,7 @@ impl MeshGeometry {
         let s = self.scale;
         let mut faces: HashMap<FaceKey, (u32, Vec<u32>, u8)> = HashMap::new();
         for (k, e) in cells.iter().enumerate() {
-            for f in faces_of(e.kind) {
+            for f in e.kind.facets() {
                 let nodes: Vec<u32> = f.iter().map(|&i| e.nodes[i]).collect();
                 faces
                     .entry(key_of(&nodes))

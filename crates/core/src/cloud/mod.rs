@@ -10,7 +10,7 @@ pub mod mesh;
 pub mod order;
 
 use crate::error::{Error, Result};
-use crate::math::{NodeId, Point, Vector};
+use crate::math::{NodeId, Point, Vector, GEOMETRIC_TOLERANCE};
 use crate::symmetry::Symmetry;
 use facets::FacetSet;
 
@@ -381,8 +381,6 @@ pub struct BoxGeometry {
     pub regions: Vec<BoxRegion>,
 }
 
-const REL: f64 = 1e-9;
-
 impl BoxGeometry {
     /// Checks the tiling and the lattices; errors name the region.
     pub fn validate(&self) -> Result<()> {
@@ -403,7 +401,8 @@ impl BoxGeometry {
                 if reg.max[a] <= reg.min[a] {
                     return Err(Error::model(&key, "max must exceed min on every axis"));
                 }
-                if reg.min[a] < self.min[a] - REL * scale || reg.max[a] > self.max[a] + REL * scale
+                if reg.min[a] < self.min[a] - GEOMETRIC_TOLERANCE * scale
+                    || reg.max[a] > self.max[a] + GEOMETRIC_TOLERANCE * scale
                 {
                     return Err(Error::model(&key, "region extends outside the domain"));
                 }
@@ -429,7 +428,7 @@ impl BoxGeometry {
                 let overlap: f64 = (0..self.dim)
                     .map(|a| (reg.max[a].min(other.max[a]) - reg.min[a].max(other.min[a])).max(0.0))
                     .product();
-                if overlap > REL * total {
+                if overlap > GEOMETRIC_TOLERANCE * total {
                     return Err(Error::model(
                         &key,
                         format!("overlaps region {}", other.name),
@@ -467,7 +466,7 @@ impl BoxGeometry {
         let scale = (0..self.dim)
             .map(|a| self.max[a] - self.min[a])
             .fold(0.0, f64::max);
-        let eps = REL * scale;
+        let eps = GEOMETRIC_TOLERANCE * scale;
         let on_face = |reg: &BoxRegion, face: Face| {
             let a = face / 2;
             if face.is_multiple_of(2) {
