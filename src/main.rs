@@ -523,56 +523,16 @@ fn sweep(
     against: Option<PathBuf>,
     exclude_tips: f64,
 ) -> anyhow::Result<()> {
-    use peritherm::sweep::{self, Against};
+    use peritherm::sweep;
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
     }
-    let mut variants = Vec::new();
-    for path in cases {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read", path.display()))?;
-        let prefix = if cases.len() > 1 {
-            path.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        } else {
-            String::new()
-        };
-        let mut v = sweep::variants(&text, path, &prefix, vary)?;
-        if v.len() == 1 && v[0].label.is_empty() {
-            v[0].label = "run".into();
-        }
-        variants.extend(v);
-    }
-    let against = match against {
-        Some(dir) => Against::Run(dir),
-        None if variants.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
-        None => Against::First,
-    };
+    let (variants, against) = sweep::study(cases, vary, against)?;
     let n = variants.len();
     let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
         eprintln!("[{}/{n}] {label}", k + 1);
     })?;
-    let mut table = sweep::markdown(&rows);
-    let rates = sweep::convergence_plots(&rows, out)?;
-    let lines = sweep::line_plots(&variants, &rows, out, &against)?;
-    if !rates.is_empty() {
-        table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
-        for (stem, series, rate) in &rates {
-            table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
-        }
-    }
-    let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
-    plots.dedup();
-    plots.extend(lines.iter());
-    if !plots.is_empty() {
-        table.push('\n');
-        for p in plots {
-            table.push_str(&format!("![{p}]({p}.png)\n\n"));
-        }
-    }
-    peritherm::atomic::write_atomic(&out.join("sweep.csv"), sweep::csv(&rows).as_bytes())?;
-    peritherm::atomic::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    let (table, _) = sweep::write_study(&variants, &rows, out, &against)?;
     say!("{table}");
     say!("-> {}", out.join("sweep.md").display());
     Ok(())

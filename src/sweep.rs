@@ -740,6 +740,75 @@ pub fn line_plots(
     Ok(stems)
 }
 
+/// The variants of a study and what they are compared with: every file of `cases` swept over
+/// `vary` (labels prefixed with the file's stem when several files are compared), against the
+/// run directory `against`, else each variant's own reference when every variant has one, else
+/// the first variant. What `peritherm sweep` and the Python `sweep` run.
+pub fn study(
+    cases: &[PathBuf],
+    vary: &[Vary],
+    against: Option<PathBuf>,
+) -> Result<(Vec<Variant>, Against)> {
+    let mut all = Vec::new();
+    for path in cases {
+        let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+            path: path.clone(),
+            error,
+        })?;
+        let prefix = if cases.len() > 1 {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
+        let mut v = variants(&text, path, &prefix, vary)?;
+        if v.len() == 1 && v[0].label.is_empty() {
+            v[0].label = "run".into();
+        }
+        all.extend(v);
+    }
+    let against = match against {
+        Some(dir) => Against::Run(dir),
+        None if all.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
+        None => Against::First,
+    };
+    Ok((all, against))
+}
+
+/// Writes a finished study into `out`: sweep.csv (one row per variant and output time) and
+/// sweep.md (the table, the fitted convergence rates and the plots, which it draws); returns
+/// the Markdown and the CSV text.
+pub fn write_study(
+    variants: &[Variant],
+    rows: &[Row],
+    out: &Path,
+    against: &Against,
+) -> Result<(String, String)> {
+    let mut table = markdown(rows);
+    let rates = convergence_plots(rows, out)?;
+    let lines = line_plots(variants, rows, out, against)?;
+    if !rates.is_empty() {
+        table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
+        for (stem, series, rate) in &rates {
+            table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
+        }
+    }
+    let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
+    plots.dedup();
+    plots.extend(lines.iter());
+    if !plots.is_empty() {
+        table.push('\n');
+        for p in plots {
+            table.push_str(&format!("![{p}]({p}.png)\n\n"));
+        }
+    }
+    let csv = csv(rows);
+    crate::atomic::write_atomic(&out.join("sweep.csv"), csv.as_bytes())?;
+    crate::atomic::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    Ok((table, csv))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

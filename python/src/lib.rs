@@ -790,7 +790,7 @@ fn sweep<'py>(
     against: Option<PathBuf>,
     exclude_tips: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use peritherm::sweep::{self, Against, Vary};
+    use peritherm::sweep::{self, Vary};
     if cases.is_empty() {
         return Err(PyValueError::new_err("cases: give at least one case file"));
     }
@@ -806,53 +806,10 @@ fn sweep<'py>(
                 .map_err(|e| PyValueError::new_err(format!("vary: {e}")))
         })
         .collect::<PyResult<_>>()?;
-    // the variants as `peritherm sweep` builds them (src/main.rs)
-    let mut variants = Vec::new();
-    for path in &cases {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            PyValueError::new_err(format!("{}: -: cannot read: {e}", path.display()))
-        })?;
-        let prefix = if cases.len() > 1 {
-            path.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        } else {
-            String::new()
-        };
-        let mut v = sweep::variants(&text, path, &prefix, &vary).map_err(py_err)?;
-        if v.len() == 1 && v[0].label.is_empty() {
-            v[0].label = "run".into();
-        }
-        variants.extend(v);
-    }
-    let against = match against {
-        Some(dir) => Against::Run(dir),
-        None if variants.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
-        None => Against::First,
-    };
+    let (variants, against) = sweep::study(&cases, &vary, against).map_err(py_err)?;
     let (rows, table, csv) = interruptible(py, |check| {
         let rows = sweep::run(&variants, &out, &against, exclude_tips, |_, _| check())?;
-        let mut table = sweep::markdown(&rows);
-        let rates = sweep::convergence_plots(&rows, &out)?;
-        let lines = sweep::line_plots(&variants, &rows, &out, &against)?;
-        if !rates.is_empty() {
-            table.push_str("\n| plot | measure | fitted rate |\n|---|---|---|\n");
-            for (stem, series, rate) in &rates {
-                table.push_str(&format!("| {stem} | {series} | {rate:.3} |\n"));
-            }
-        }
-        let mut plots: Vec<&String> = rates.iter().map(|r| &r.0).collect();
-        plots.dedup();
-        plots.extend(lines.iter());
-        if !plots.is_empty() {
-            table.push('\n');
-            for p in plots {
-                table.push_str(&format!("![{p}]({p}.png)\n\n"));
-            }
-        }
-        let csv = sweep::csv(&rows);
-        peritherm::atomic::write_atomic(&out.join("sweep.csv"), csv.as_bytes())?;
-        peritherm::atomic::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+        let (table, csv) = sweep::write_study(&variants, &rows, &out, &against)?;
         Ok((rows, table, csv))
     })?;
     let d = PyDict::new(py);
