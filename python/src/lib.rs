@@ -754,16 +754,13 @@ fn fem<'py>(
         Ok(c) => c.get().case.clone(),
         Err(_) => Arc::new(Case::load(&path_arg(case)?).map_err(py_err)?),
     };
-    let scheme = match scheme.replace('_', "-").as_str() {
-        "crank-nicolson" => Scheme::CrankNicolson,
-        "backward-euler" => Scheme::BackwardEuler,
-        "steady" => Scheme::Steady,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "scheme: `{other}` is not one of crank-nicolson, backward-euler, steady"
-            )))
-        }
-    };
+    let scheme = Scheme::from_name(scheme).ok_or_else(|| {
+        let names: Vec<&str> = Scheme::ALL.iter().map(|s| s.name()).collect();
+        PyValueError::new_err(format!(
+            "scheme: `{scheme}` is not one of {}",
+            names.join(", ")
+        ))
+    })?;
     let out = path_arg(out)?;
     let opts = FemOptions {
         h,

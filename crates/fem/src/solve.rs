@@ -91,6 +91,15 @@ pub enum Scheme {
 }
 
 impl Scheme {
+    /// Every scheme, in the order their names are listed to users.
+    pub const ALL: [Scheme; 3] = [Scheme::CrankNicolson, Scheme::BackwardEuler, Scheme::Steady];
+
+    /// The scheme of [`Scheme::name`] `name` (`_` read as `-`), if there is one.
+    pub fn from_name(name: &str) -> Option<Scheme> {
+        let name = name.replace('_', "-");
+        Scheme::ALL.into_iter().find(|s| s.name() == name)
+    }
+
     /// The name written to run.json.
     pub fn name(self) -> &'static str {
         match self {
@@ -313,5 +322,21 @@ impl<'a> Stepper<'a> {
         self.cond.impose(self.mesh, t, theta);
         self.lift(theta, 0.0, 1.0);
         self.solve_into(k, theta, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Scheme;
+
+    /// Every scheme is found again from its run.json name (and with `_` for `-`); other names
+    /// are not.
+    #[test]
+    fn schemes_are_found_by_name() {
+        for s in Scheme::ALL {
+            assert_eq!(Scheme::from_name(s.name()), Some(s));
+            assert_eq!(Scheme::from_name(&s.name().replace('-', "_")), Some(s));
+        }
+        assert_eq!(Scheme::from_name("bdf2"), None);
     }
 }
