@@ -57,8 +57,8 @@ enum Command {
         #[arg(long)]
         h: Option<f64>,
         /// Time scheme (Crank–Nicolson starts with four backward-Euler half steps).
-        #[arg(long, value_enum, default_value = "crank-nicolson")]
-        scheme: FemScheme,
+        #[arg(long, value_parser = parse_scheme, default_value = "crank-nicolson")]
+        scheme: Scheme,
         /// Time step, s (default: min(end/1000, first output/100)).
         #[arg(long)]
         dt: Option<f64>,
@@ -149,15 +149,12 @@ enum Command {
     },
 }
 
-/// Time schemes of `peritherm fem`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum FemScheme {
-    /// Backward Euler (first order, no oscillations).
-    BackwardEuler,
-    /// Crank–Nicolson (second order).
-    CrankNicolson,
-    /// The steady state at every output time.
-    Steady,
+/// Parses a time scheme of `peritherm fem` by its run.json name ([`Scheme::from_name`]).
+fn parse_scheme(s: &str) -> Result<Scheme, String> {
+    Scheme::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Scheme::ALL.iter().map(|s| s.name()).collect();
+        format!("`{s}` is not one of {}", names.join(", "))
+    })
 }
 
 /// Parses a count such as `1000000` or `1e7`.
@@ -254,11 +251,6 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             quiet,
         } => {
             let case = Case::load(&case)?;
-            let scheme = match scheme {
-                FemScheme::BackwardEuler => Scheme::BackwardEuler,
-                FemScheme::CrankNicolson => Scheme::CrankNicolson,
-                FemScheme::Steady => Scheme::Steady,
-            };
             let bar = ProgressBar::new(0);
             if quiet || !std::io::stderr().is_terminal() {
                 bar.set_draw_target(ProgressDrawTarget::hidden());

@@ -8,9 +8,8 @@ use crate::cloud::FACE_NAMES;
 use crate::error::{Error, Result};
 use crate::limits::MAX_STEPS;
 use crate::model::{Geometry, Model};
-use crate::solve::enthalpy::Enthalpic;
-use crate::solve::explicit::{choose_dt, count_steps, Integrator};
-use crate::solve::implicit::{Adaptive, Implicit, Options as ImplicitOptions, Scheme, Solver};
+use crate::solve::implicit::Adaptive;
+use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
 
 /// Settings of a run that are not part of the case.
 #[derive(Debug, Clone, Copy, Default)]
@@ -27,10 +26,21 @@ pub struct Plan<'a> {
     pub adaptive: Option<Adaptive>,
     /// Steps of a fixed-step run (0 when not known up front).
     pub total: u64,
-    /// The enthalpy stepper of a phase-change model.
-    pub enthalpic: Option<Enthalpic<'a>>,
-    /// The implicit stepper (system eliminated and factorised symbolically).
-    pub implicit: Option<Implicit<'a>>,
+    /// Whether the run is the steady solve at each output time (no steps).
+    pub steady: bool,
+    /// The stepper ([`Engine::new`]: explicit, enthalpy or implicit, set up).
+    pub engine: Engine<'a>,
+}
+
+impl Plan<'_> {
+    /// How the run steps: [`Plan::dt`], [`Plan::adaptive`], [`Plan::steady`].
+    pub fn schedule(&self) -> Schedule {
+        Schedule {
+            dt: self.dt,
+            adaptive: self.adaptive,
+            steady: self.steady,
+        }
+    }
 }
 
 /// A library error keyed to the case file.
@@ -163,39 +173,15 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
     } else {
         0
     };
-    let scheme = match case.integrator {
-        Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
-        Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
-        Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
-        Integrator::Euler | Integrator::Rk4 => None,
-    };
-    // phase change: the enthalpy form of forward Euler (the axisymmetric phase-change paper,
-    // doi:10.1007/s42102-022-00092-3), refusing other integrators
-    let enthalpic = match model.enthalpy {
-        Some(_) => Some(Enthalpic::new(model, case.integrator).map_err(|e| keyed(case, e))?),
-        None => None,
-    };
-    // the implicit system (elimination, symbolic factorisation) is part of the set-up
-    let implicit = match scheme {
-        Some(s) => {
-            // adaptive steps visit several Δt: CG until a factorisation pays (Solver::Auto)
-            let options = ImplicitOptions {
-                solver: match adaptive {
-                    Some(_) => Solver::Auto,
-                    None => Solver::Direct,
-                },
-                ..ImplicitOptions::default()
-            };
-            Some(Implicit::new(model, s, options).map_err(|e| keyed(case, e))?)
-        }
-        None => None,
-    };
+    // the stepper's set-up (implicit: elimination, symbolic factorisation) is part of the plan
+    let engine =
+        Engine::new(model, case.integrator, adaptive.is_some()).map_err(|e| keyed(case, e))?;
     Ok(Plan {
         dt,
         adaptive,
         total,
-        enthalpic,
-        implicit,
+        steady: case.integrator == Integrator::Steady,
+        engine,
     })
 }
 

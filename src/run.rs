@@ -8,12 +8,13 @@ use crate::fem::run_fem;
 use crate::history::{output_index, Recorder};
 use crate::model::crack_cutters;
 use crate::model::Model;
+use crate::operator::Conductance;
 use crate::output::read_field;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, RunSummary};
 use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
-use crate::solve::explicit::{Explicit, Integrator};
+use crate::solve::{integrate, Engine, Integrator, RunStats, Schedule};
 use crate::staging::{reached, write_into};
 use std::path::Path;
 use std::sync::Arc;
@@ -62,12 +63,9 @@ fn execute(
     t_setup: Instant,
     mut progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary> {
+    let schedule = plan.schedule();
     let Plan {
-        dt,
-        adaptive,
-        total,
-        mut enthalpic,
-        mut implicit,
+        total, mut engine, ..
     } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     // first, so that a run that fails or is interrupted also says which case it was
@@ -79,69 +77,60 @@ fn execute(
     let mut writer = OutputWriter::new(case, model, out)?;
     let fem_seconds = started.elapsed().as_secs_f64();
     let reference = writer.reference.clone();
-    let mut on_output =
-        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
-            writer.write(k, t, th, conductance, e)
-        };
     // the steppers stop at the outputs and at the history's samples
     let times = case.times();
     let mut recorder = recorder(case, model, reference.as_ref(), &theta);
-    let mut on_output =
-        |k: usize, t: f64, th: &[f64], conductance: &crate::operator::Conductance, e: f64| {
-            // an interrupted run reports at least the last output it wrote
+    let on_output = |k: usize, t: f64, th: &[f64], conductance: &Conductance, e: f64| {
+        // an interrupted run reports at least the last output it wrote
+        reached(t);
+        if let Some(r) = recorder.as_mut() {
+            r.record(t, th);
+        }
+        match output_index(&case.outputs, times[k]) {
+            Some(f) => writer.write(f, t, th, conductance, e),
+            None => Ok(()),
+        }
+    };
+    let t_last = case.outputs.last().copied().unwrap_or(case.end);
+    let adaptive = schedule.adaptive.is_some();
+    let stats = integrate(
+        &mut engine,
+        &schedule,
+        &mut theta,
+        0.0,
+        &times,
+        on_output,
+        |s, t| {
             reached(t);
-            if let Some(r) = recorder.as_mut() {
-                r.record(t, th);
+            // adaptive: the number of steps is not known; extrapolate it from the time reached
+            match adaptive {
+                true => progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64),
+                false => progress(s, total),
             }
-            match output_index(&case.outputs, times[k]) {
-                Some(f) => on_output(f, t, th, conductance, e),
-                None => Ok(()),
-            }
-        };
-    let linear_output = |k: usize, t: f64, th: &[f64], c: &crate::operator::Conductance| {
-        on_output(k, t, th, c, model.energy(th))
+        },
+    )
+    .map_err(|e| run_error(case, model, e))?;
+    let history = match &recorder {
+        Some(r) => Some(r.write(out)?),
+        None => None,
     };
-    let result = match (enthalpic.as_mut(), implicit.as_mut()) {
-        (Some(stepper), _) => stepper.run(&mut theta, 0.0, dt, &times, &mut on_output, |s| {
-            reached(s as f64 * dt);
-            progress(s, total)
-        }),
-        (None, Some(stepper)) if case.integrator == Integrator::Steady => {
-            stepper.steady(&mut theta, &times, linear_output)
-        }
-        (None, Some(stepper)) if adaptive.is_some() => {
-            let adaptive = adaptive.as_ref().expect("adaptive");
-            let t_last = case.outputs.last().copied().unwrap_or(case.end);
-            stepper.run_adaptive(
-                &mut theta,
-                0.0,
-                adaptive,
-                &times,
-                linear_output,
-                // the number of steps is not known: extrapolate it from the time reached
-                |s, t| {
-                    reached(t);
-                    progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64)
-                },
-            )
-        }
-        (None, Some(stepper)) => stepper.run(&mut theta, 0.0, dt, &times, linear_output, |s| {
-            reached(s as f64 * dt);
-            progress(s, total)
-        }),
-        (None, None) => Explicit::new(model, case.integrator).run(
-            &mut theta,
-            0.0,
-            dt,
-            &times,
-            linear_output,
-            |s| {
-                reached(s as f64 * dt);
-                progress(s, total)
-            },
-        ),
+    let timing = Timing {
+        setup_seconds,
+        run_seconds: t_run.elapsed().as_secs_f64(),
+        fem_seconds,
     };
-    let stats = result.map_err(|e| match e {
+    let mut summary = summary(case, model, &schedule, &engine, stats, writer, timing);
+    summary.initial_energy = initial_energy;
+    summary.history = history;
+    summary.origin = Some(origin);
+    summary.write(out)?;
+    Ok(summary)
+}
+
+/// A time-loop error keyed to the case: a non-finite temperature names the key that most
+/// likely caused it ([`likely_cause`]).
+fn run_error(case: &Case, model: &Model, e: Error) -> Error {
+    match e {
         Error::NonFinite { node, time } => {
             let p = model.cloud.pos[node];
             case.error(
@@ -153,12 +142,32 @@ fn execute(
             )
         }
         other => keyed(case, other),
-    })?;
-    let history = match &recorder {
-        Some(r) => Some(r.write(out)?),
-        None => None,
-    };
-    let summary = RunSummary {
+    }
+}
+
+/// Wall-clock times of a run, s.
+struct Timing {
+    /// Building the model and planning the time loop.
+    setup_seconds: f64,
+    /// The time loop, output and references included.
+    run_seconds: f64,
+    /// Solving a `[reference.fem]` before the time loop.
+    fem_seconds: f64,
+}
+
+/// The run.json of a finished run (without its initial energy, history and origin).
+fn summary(
+    case: &Case,
+    model: &Model,
+    schedule: &Schedule,
+    engine: &Engine,
+    stats: RunStats,
+    writer: OutputWriter,
+    timing: Timing,
+) -> RunSummary {
+    let implicit = engine.implicit();
+    let dt = schedule.dt;
+    RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
         case: case.path.display().to_string(),
@@ -170,7 +179,7 @@ fn execute(
         steps: stats.steps,
         // implicit runs: the step taken (adaptive: the first; 0 for steady) and, for
         // comparison, Euler's bound
-        dt: match (&implicit, adaptive) {
+        dt: match (implicit, schedule.adaptive) {
             (Some(st), Some(_)) => st.stats.first_step,
             _ if dt.is_finite() => dt,
             _ => 0.0,
@@ -183,20 +192,18 @@ fn execute(
         integrator: case.integrator.name().into(),
         output_times: case.outputs.clone(),
         fields: writer.fields,
-        initial_energy,
+        initial_energy: 0.0,
         energy: writer.energy,
-        setup_seconds,
-        wall_seconds: t_run.elapsed().as_secs_f64() - writer.reference_seconds - fem_seconds,
-        reference_seconds: writer.reference_seconds + fem_seconds,
+        setup_seconds: timing.setup_seconds,
+        wall_seconds: timing.run_seconds - writer.reference_seconds - timing.fem_seconds,
+        reference_seconds: writer.reference_seconds + timing.fem_seconds,
         threads: rayon::current_num_threads(),
         consistency: model.correction,
         reference: writer.comparisons,
-        implicit: implicit.as_ref().map(|st| st.stats),
-        history,
-        origin: Some(origin),
-    };
-    summary.write(out)?;
-    Ok(summary)
+        implicit: implicit.map(|st| st.stats),
+        history: None,
+        origin: None,
+    }
 }
 
 /// What a run writes at each output time into its (staged) directory: `field_<k>.csv` and

@@ -12,19 +12,10 @@ use crate::math::Vector;
 use crate::model::Model;
 use crate::operator::Conductance;
 use crate::prepare::{keyed, plan};
-use crate::solve::enthalpy::Enthalpic;
-use crate::solve::explicit::{check_finite, steps_between, Explicit, Integrator};
-use crate::solve::implicit::{Adaptive, Implicit};
+use crate::solve::{check_finite, integrate, steps_between, Engine, Schedule};
 
 /// Steps between two calls of the `keep_going` callback of the stepping methods.
 pub const CHECK_EVERY: u64 = 64;
-
-/// The stepper of a case, as [`crate::run::run_case`] chooses it.
-enum Engine<'a> {
-    Explicit(Explicit<'a>),
-    Enthalpic(Enthalpic<'a>),
-    Implicit(Box<Implicit<'a>>),
-}
 
 /// The fields at one output time of [`Simulation::run`].
 #[derive(Debug, Clone)]
@@ -45,8 +36,9 @@ pub struct Snapshot {
 pub struct Simulation<'a> {
     case: &'a Case,
     model: &'a Model,
-    dt: f64,
-    adaptive: Option<Adaptive>,
+    /// How the case's run steps (the step, adaptive steps, the steady solve).
+    schedule: Schedule,
+    /// The stepper of the plan, as a run has it.
     engine: Engine<'a>,
     theta: Vec<f64>,
     t: f64,
@@ -60,17 +52,11 @@ impl<'a> Simulation<'a> {
     /// the step, the steppers) and starts from the model's initial field at t = 0 s.
     pub fn new(case: &'a Case, model: &'a Model) -> Result<Self> {
         let plan = plan(case, model)?;
-        let engine = match (plan.enthalpic, plan.implicit) {
-            (Some(e), _) => Engine::Enthalpic(e),
-            (None, Some(i)) => Engine::Implicit(Box::new(i)),
-            (None, None) => Engine::Explicit(Explicit::new(model, case.integrator)),
-        };
         Ok(Simulation {
             case,
             model,
-            dt: plan.dt,
-            adaptive: plan.adaptive,
-            engine,
+            schedule: plan.schedule(),
+            engine: plan.engine,
             theta: model.theta0.clone(),
             t: 0.0,
             steps: 0,
@@ -96,7 +82,7 @@ impl<'a> Simulation<'a> {
     /// The run's fixed step, s (the case's `time.dt` or 0.95 of the stable step; infinite for
     /// the steady solve, the first step or 0 for adaptive steps).
     pub fn dt(&self) -> f64 {
-        self.dt
+        self.schedule.dt
     }
 
     /// Temperature of every node (body first, then fictitious), °C.
@@ -129,17 +115,14 @@ impl<'a> Simulation<'a> {
             .boundary
             .apply(&self.model.cloud, &mut self.theta, self.t);
         self.started = false;
-        if let Engine::Enthalpic(e) = &mut self.engine {
-            e.restart();
-        }
         Ok(())
     }
 
     /// Refuses stepping by hand when the case's time loop is not a fixed-step one.
     fn fixed(&self) -> Result<()> {
-        let why = if self.adaptive.is_some() {
+        let why = if self.schedule.adaptive.is_some() {
             "time.tolerance"
-        } else if self.case.integrator == Integrator::Steady {
+        } else if self.schedule.steady {
             "time.integrator"
         } else {
             return Ok(());
@@ -153,10 +136,10 @@ impl<'a> Simulation<'a> {
         ))
     }
 
-    /// Starts the implicit stepper from the current field once.
+    /// Starts the stepper from the current field once ([`crate::solve::Stepper::begin`]).
     fn begin(&mut self) {
-        if let (Engine::Implicit(i), false) = (&mut self.engine, self.started) {
-            i.start(&self.theta, self.t);
+        if !self.started {
+            self.engine.stepper().begin(&mut self.theta, self.t);
         }
         self.started = true;
     }
@@ -166,7 +149,7 @@ impl<'a> Simulation<'a> {
     /// Returns whether all `n` steps were taken.
     pub fn step(&mut self, n: u64, keep_going: impl FnMut(u64) -> bool) -> Result<bool> {
         self.fixed()?;
-        let (t, h) = (self.t, self.dt);
+        let (t, h) = (self.t, self.schedule.dt);
         self.steps_of(n, t, h, t + n as f64 * h, keep_going)
     }
 
@@ -182,7 +165,7 @@ impl<'a> Simulation<'a> {
             ));
         }
         let t = self.t;
-        let n = steps_between(t, to, self.dt);
+        let n = steps_between(t, to, self.schedule.dt);
         let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
         self.steps_of(n, t, h, to, keep_going)
     }
@@ -197,7 +180,6 @@ impl<'a> Simulation<'a> {
         mut keep_going: impl FnMut(u64) -> bool,
     ) -> Result<bool> {
         self.begin();
-        let nb = self.model.cloud.n_body;
         let mut done = 0;
         let mut stopped = false;
         while done < n {
@@ -207,16 +189,15 @@ impl<'a> Simulation<'a> {
             } else {
                 t + (done + 1) as f64 * h
             };
-            match &mut self.engine {
-                Engine::Explicit(e) => e.step(&mut self.theta, tn, h),
-                Engine::Enthalpic(e) => e.step(&mut self.theta, tn, h),
-                Engine::Implicit(i) => i.step(tn, t1, h).map_err(|e| keyed(self.case, e))?,
-            }
+            let stepper = self.engine.stepper();
+            stepper
+                .advance(&mut self.theta, tn, t1, h)
+                .map_err(|e| keyed(self.case, e))?;
             done += 1;
             self.steps += 1;
             self.t = t1;
-            if self.steps.is_multiple_of(4096) && !matches!(self.engine, Engine::Implicit(_)) {
-                check_finite(&self.theta, nb, self.t)?;
+            if self.steps.is_multiple_of(4096) {
+                stepper.check(&self.theta, self.t)?;
             }
             if done < n && done.is_multiple_of(CHECK_EVERY) && !keep_going(self.steps) {
                 stopped = true;
@@ -231,31 +212,17 @@ impl<'a> Simulation<'a> {
     /// constrained nodes set), growing cracks cut, and a finite check.
     fn settle(&mut self) -> Result<()> {
         let t = self.t;
-        match &mut self.engine {
-            Engine::Implicit(i) => i.state_into(&mut self.theta, t)?,
-            Engine::Explicit(e) => e.cut_until(t),
-            Engine::Enthalpic(_) => {}
-        }
+        self.engine.stepper().settle(&mut self.theta, t)?;
         check_finite(&self.theta, self.model.cloud.n_body, t)
     }
 
     /// K as it is now (growing cracks cut; with phase change, the current conductivities),
     /// W/K.
     pub fn conductance(&mut self) -> &Conductance {
-        match &mut self.engine {
-            Engine::Explicit(e) => {
-                e.cut_until(self.t);
-                e.conductance()
-            }
-            Engine::Enthalpic(e) => {
-                // the conductivities need the enthalpies: set them now as the first step would
-                e.prime(&mut self.theta, self.t);
-                self.started = true;
-                e.scale_conductance();
-                e.scaled()
-            }
-            Engine::Implicit(_) => &self.model.conductance,
-        }
+        // phase change: the conductivities need the enthalpies; set them now as the first
+        // step would (growing cracks: the bonds cut by now)
+        self.begin();
+        self.engine.stepper().conductance_now()
     }
 
     /// Peridynamic heat flux of every body node now (theory §8), W/m².
@@ -275,9 +242,10 @@ impl<'a> Simulation<'a> {
     /// Energy of the body now, J, as a run's `energy`: Σ V_i ρc_i θ_i, or with phase change
     /// Σ V_i H_i of the stepper (before the first step, [`Model::energy`]).
     pub fn energy(&self) -> f64 {
-        match &self.engine {
-            Engine::Enthalpic(e) if self.started => e.energy(),
-            _ => self.model.energy(&self.theta),
+        if self.started {
+            self.engine.stepper_ref().energy_now(&self.theta)
+        } else {
+            self.model.energy(&self.theta)
         }
     }
 
@@ -322,27 +290,28 @@ impl<'a> Simulation<'a> {
             }
             return Ok((snapshots, true));
         }
-        let Engine::Implicit(stepper) = &mut self.engine else {
-            unreachable!("adaptive steps and the steady solve are implicit")
-        };
         let model = self.model;
         let mut theta = std::mem::take(&mut self.theta);
-        let mut collect = |_: usize, t: f64, th: &[f64], k: &Conductance| {
+        let collect = |_: usize, t: f64, th: &[f64], k: &Conductance, energy: f64| {
             snapshots.push(Snapshot {
                 time: t,
                 theta: th.to_vec(),
                 flux: k.flux(&model.cloud, th),
                 damage: model.damage_at(t),
-                energy: model.energy(th),
+                energy,
             });
             Ok(())
         };
-        let result = match self.adaptive {
-            Some(a) => {
-                stepper.run_adaptive(&mut theta, self.t, &a, outputs, &mut collect, |_, _| {})
-            }
-            None => stepper.steady(&mut theta, outputs, &mut collect),
-        };
+        // adaptive steps or the steady solve: the implicit stepper's own loops
+        let result = integrate(
+            &mut self.engine,
+            &self.schedule,
+            &mut theta,
+            self.t,
+            outputs,
+            collect,
+            |_, _| {},
+        );
         self.theta = theta;
         let stats = result.map_err(|e| keyed(self.case, e))?;
         self.steps += stats.steps;

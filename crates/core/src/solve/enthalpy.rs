@@ -12,7 +12,8 @@ use crate::error::{Error, Result};
 use crate::material::Enthalpy;
 use crate::model::Model;
 use crate::operator::Conductance;
-use crate::solve::explicit::{march, Integrator, RunStats, Stepper};
+use crate::solve::integrator::Integrator;
+use crate::solve::stepper::{check_finite, march, RunStats, Stepper};
 use rayon::prelude::*;
 
 /// Enthalpy-form explicit integrator state with preallocated buffers.
@@ -245,10 +246,28 @@ impl<'a> Enthalpic<'a> {
 }
 
 impl Stepper for Enthalpic<'_> {
-    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64) {
-        self.step(theta, t, h);
-    }
     fn n_body(&self) -> usize {
         self.model.cloud.n_body
+    }
+    fn begin(&mut self, theta: &mut [f64], t: f64) {
+        self.start(theta, t);
+    }
+    fn advance(&mut self, theta: &mut [f64], t: f64, _t1: f64, h: f64) -> Result<()> {
+        self.step(theta, t, h);
+        Ok(())
+    }
+    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        check_finite(theta, self.model.cloud.n_body, t)
+    }
+    fn conductance_now(&mut self) -> &Conductance {
+        self.scale_conductance();
+        &self.scaled
+    }
+    fn energy_now(&self, theta: &[f64]) -> f64 {
+        if self.ready {
+            self.energy()
+        } else {
+            self.model.energy(theta)
+        }
     }
 }

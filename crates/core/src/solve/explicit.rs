@@ -5,126 +5,17 @@
 //! (Dirichlet, flux relations) and fictitious nodes are set by the boundary at every stage.
 //! Buffers are allocated once; the bond sum is a parallel gather.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::Model;
 use crate::operator::{row_sum, Conductance, ROW_CHUNK};
 use crate::stencil::Stencils;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
-/// Time integrator of `time.integrator`: the explicit ones here, the implicit ones and the
-/// steady solve in [`crate::solve::implicit`] (theory §4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Integrator {
-    /// Forward Euler, stable for Δt ≤ 2/λ_max.
-    Euler,
-    /// Classical fourth-order Runge–Kutta, stable for Δt ≤ 2.78/λ_max.
-    Rk4,
-    /// Backward Euler (implicit, first order, no stability bound).
-    BackwardEuler,
-    /// Crank–Nicolson (implicit, second order, no stability bound).
-    CrankNicolson,
-    /// BDF2 (implicit, second order, no stability bound).
-    Bdf2,
-    /// Steady state A θ = f(t) at each output time (no time stepping).
-    Steady,
-}
-
-impl Integrator {
-    /// Name for messages.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Integrator::Euler => "euler",
-            Integrator::Rk4 => "rk4",
-            Integrator::BackwardEuler => "backward_euler",
-            Integrator::CrankNicolson => "crank_nicolson",
-            Integrator::Bdf2 => "bdf2",
-            Integrator::Steady => "steady",
-        }
-    }
-    /// True for the implicit schemes and the steady solve ([`crate::solve::implicit`]).
-    pub fn is_implicit(&self) -> bool {
-        !matches!(self, Integrator::Euler | Integrator::Rk4)
-    }
-    /// Stability-region extent on the negative real axis (theory §4); infinite for the
-    /// implicit schemes (A-stable).
-    pub fn stability(&self) -> f64 {
-        match self {
-            Integrator::Euler => 2.0,
-            Integrator::Rk4 => 2.78,
-            _ => f64::INFINITY,
-        }
-    }
-    /// Largest stable step for a model, s.
-    pub fn stable_dt(&self, model: &Model) -> f64 {
-        let l = model.lambda_max();
-        if l > 0.0 {
-            self.stability() / l
-        } else {
-            f64::INFINITY
-        }
-    }
-}
-
-/// Summary of a run.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct RunStats {
-    /// Time steps taken.
-    pub steps: u64,
-}
-
-/// Chooses the step: the user's (checked against the bound) or 0.95 of the bound; implicit
-/// integrators need the user's step (no bound), the steady solve none (infinite).
-pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Result<f64> {
-    if integrator == Integrator::Steady {
-        return Ok(f64::INFINITY);
-    }
-    if integrator.is_implicit() {
-        return match user {
-            Some(dt) => Ok(dt),
-            None => Err(Error::model(
-                "time.dt",
-                format!(
-                    "is required for the implicit integrator {} (no stability bound to default to), unless time.tolerance asks for adaptive steps",
-                    integrator.name()
-                ),
-            )),
-        };
-    }
-    let bound = integrator.stable_dt(model);
-    match user {
-        Some(dt) if dt > bound => Err(Error::UnstableDt {
-            dt,
-            bound,
-            integrator: integrator.name(),
-        }),
-        Some(dt) => Ok(dt),
-        None if bound.is_finite() => Ok(0.95 * bound),
-        None => Err(Error::model(
-            "time.dt",
-            "every node is driven; give time.dt explicitly",
-        )),
-    }
-}
-
-/// Steps from `t` to `to` when no step may exceed `dt` (a relative 1e-12 slack keeps
-/// round-off from adding a step).
-pub fn steps_between(t: f64, to: f64, dt: f64) -> u64 {
-    ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64
-}
-
-/// Number of steps from `t0` to each output time with steps no longer than `dt`.
-pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
-    let mut t = t0;
-    let mut n = 0;
-    for &to in outputs {
-        n += steps_between(t, to, dt);
-        t = to;
-    }
-    n
-}
+// the integrator and the stepping interface under their old paths
+pub use crate::solve::integrator::{choose_dt, count_steps, steps_between, Integrator};
+pub use crate::solve::stepper::{check_finite, RunStats};
+use crate::solve::stepper::{march, Stepper};
 
 fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64]) {
     rates_with(model, k, None, theta, t, out);
@@ -401,67 +292,34 @@ impl<'a> Explicit<'a> {
             t0,
             dt,
             outputs,
-            |me, k, t, theta| {
-                me.cut_until(t);
-                on_output(k, t, theta, &me.conductance)
-            },
+            |me, k, t, theta| on_output(k, t, theta, &me.conductance),
             progress,
         )
     }
 }
 
-/// A fixed-step explicit integrator that [`march`] can drive.
-pub(crate) trait Stepper {
-    /// Advances the body temperatures in `theta` from t over h, s.
-    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64);
-    /// Number of body nodes (the entries of θ that are checked for NaN).
-    fn n_body(&self) -> usize;
-}
-
 impl Stepper for Explicit<'_> {
-    fn advance(&mut self, theta: &mut [f64], t: f64, h: f64) {
-        self.step(theta, t, h);
-    }
     fn n_body(&self) -> usize {
         self.model.cloud.n_body
     }
-}
-
-/// The fixed-step time loop shared by the explicit integrators: steps no longer than `dt` that
-/// land on each output time, a NaN check every 4096 steps and at every output, where
-/// `at_output(stepper, k, t, θ)` is called; `progress(steps)` every 256 steps and at the end.
-pub(crate) fn march<S: Stepper>(
-    stepper: &mut S,
-    theta: &mut [f64],
-    t0: f64,
-    dt: f64,
-    outputs: &[f64],
-    mut at_output: impl FnMut(&mut S, usize, f64, &[f64]) -> Result<()>,
-    mut progress: impl FnMut(u64),
-) -> Result<RunStats> {
-    let nb = stepper.n_body();
-    let mut t = t0;
-    let mut stats = RunStats::default();
-    for (k, &to) in outputs.iter().enumerate() {
-        let n = steps_between(t, to, dt);
-        let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
-        for s in 0..n {
-            let tn = t + s as f64 * h;
-            stepper.advance(theta, tn, h);
-            stats.steps += 1;
-            if stats.steps % 256 == 0 {
-                progress(stats.steps);
-                if stats.steps % 4096 == 0 {
-                    check_finite(theta, nb, tn + h)?;
-                }
-            }
-        }
-        t = to;
-        check_finite(theta, nb, t)?;
-        at_output(stepper, k, t, theta)?;
+    fn begin(&mut self, _theta: &mut [f64], t: f64) {
+        self.cut_until(t);
     }
-    progress(stats.steps);
-    Ok(stats)
+    fn advance(&mut self, theta: &mut [f64], t: f64, _t1: f64, h: f64) -> Result<()> {
+        self.step(theta, t, h);
+        Ok(())
+    }
+    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        check_finite(theta, self.model.cloud.n_body, t)?;
+        self.cut_until(t);
+        Ok(())
+    }
+    fn conductance_now(&mut self) -> &Conductance {
+        &self.conductance
+    }
+    fn energy_now(&self, theta: &[f64]) -> f64 {
+        self.model.energy(theta)
+    }
 }
 
 fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
@@ -473,12 +331,4 @@ fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
                 *o = y + a * k;
             }
         });
-}
-
-/// Fails with [`Error::NonFinite`] at the first body node of `theta` (of `nb`) that is not finite at time `t`, s.
-pub fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
-    match theta[..nb].iter().position(|v| !v.is_finite()) {
-        Some(node) => Err(Error::NonFinite { node, time: t }),
-        None => Ok(()),
-    }
 }

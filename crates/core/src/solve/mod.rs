@@ -1,5 +1,12 @@
-//! Time integration of theory §2, eq. 1.
+//! Time integration of theory §2, eq. 1: one [`Integrator`] enum, one [`Stepper`] interface
+//! implemented by the explicit, enthalpy and implicit steppers, and the loops over the output
+//! times ([`march`], [`integrate`]).
 
 pub mod enthalpy;
 pub mod explicit;
 pub mod implicit;
+pub mod integrator;
+pub mod stepper;
+
+pub use integrator::{choose_dt, count_steps, steps_between, Integrator};
+pub use stepper::{check_finite, integrate, march, Engine, RunStats, Schedule, Stepper};

@@ -1,0 +1,387 @@
+//! Linear solvers of `(cM + A) x = b`: sparse Cholesky or LU (faer), Jacobi-preconditioned
+//! conjugate gradients, and the ski-rental choice between them ([`Solver::Auto`]).
+
+use super::Implicit;
+use super::{nested_dissection, Ordering, System};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::LltRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, SymbolicLu};
+use faer::sparse::linalg::lu::{LuRef, NumericLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::Par;
+use faer::{Conj, MatMut, Side};
+use std::time::Instant;
+
+/// Linear solver for the implicit systems.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    /// Sparse Cholesky (symmetric A) or sparse LU (nonsymmetric A), factorised once per Δt.
+    Direct,
+    /// Jacobi-preconditioned conjugate gradients (symmetric A only), warm-started.
+    Cg,
+    /// Direct, but a coefficient c not factorised yet is solved by Jacobi-PCG until the CG time
+    /// spent on it exceeds one factorisation (ski rental; symmetric A, else as `Direct`).
+    Auto,
+}
+
+/// Settings of the implicit solvers.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Linear solver.
+    pub solver: Solver,
+    /// Use rayon (products) and faer's parallel kernels; false runs everything serially.
+    pub parallel: bool,
+    /// Relative residual at which conjugate gradients stop (dimensionless).
+    pub cg_tolerance: f64,
+    /// Fill-reducing ordering for the Cholesky factor.
+    pub ordering: Ordering,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            solver: Solver::Direct,
+            parallel: true,
+            cg_tolerance: 1e-11,
+            ordering: Ordering::NestedDissection,
+        }
+    }
+}
+
+/// A failure of the linear solvers of the implicit and steady schemes (reported as
+/// [`Error::Solver`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LinearError {
+    /// The symbolic Cholesky factorisation (ordering, elimination tree) failed.
+    #[error("symbolic Cholesky: {0}")]
+    SymbolicCholesky(String),
+    /// The symbolic LU factorisation failed.
+    #[error("symbolic LU: {0}")]
+    SymbolicLu(String),
+    /// The numeric Cholesky factorisation of `cM + A` failed (c in 1/s).
+    #[error("Cholesky factorisation of cM + A (c = {c:e} 1/s) failed ({detail}); the system is singular (steady state of a body no boundary holds?) or not positive definite")]
+    Cholesky {
+        /// Coefficient c of M, 1/s.
+        c: f64,
+        /// faer's report.
+        detail: String,
+    },
+    /// The numeric LU factorisation of `cM + A` failed (c in 1/s).
+    #[error("LU factorisation of cM + A (c = {c:e} 1/s) failed ({detail}); the system is singular (steady state of a body no boundary holds?)")]
+    Lu {
+        /// Coefficient c of M, 1/s.
+        c: f64,
+        /// faer's report.
+        detail: String,
+    },
+    /// A direct solve was asked for without a symbolic factorisation (internal).
+    #[error("no symbolic factorisation for the direct solver")]
+    NoSymbolic,
+    /// Conjugate gradients did not reach their tolerance.
+    #[error("conjugate gradients did not converge in {iterations} iterations")]
+    CgDiverged {
+        /// Iterations taken.
+        iterations: u64,
+    },
+}
+
+impl From<LinearError> for Error {
+    fn from(e: LinearError) -> Error {
+        Error::Solver {
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The symbolic factorisation a solver needs and the scratch memory of its solves: Cholesky
+/// for symmetric A (nested dissection or AMD), LU for nonsymmetric A, none for CG.
+pub(super) type Symbolic = (
+    Option<SymbolicCholesky<usize>>,
+    Option<SymbolicLu<usize>>,
+    MemBuffer,
+);
+
+/// Builds the [`Symbolic`] factorisation of the pattern of A for `options.solver`.
+pub(super) fn symbolic(
+    sys: &System,
+    model: &Model,
+    options: &Options,
+    par: Par,
+) -> Result<Symbolic> {
+    let n = sys.len();
+    let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
+    Ok(match options.solver {
+        Solver::Cg => (None, None, MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
+        Solver::Direct | Solver::Auto if sys.symmetric => {
+            let (fwd, inv) = match options.ordering {
+                Ordering::NestedDissection => nested_dissection(sys, model),
+                Ordering::Amd => (Vec::new(), Vec::new()),
+            };
+            let ordering = match options.ordering {
+                Ordering::NestedDissection => {
+                    SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+                }
+                Ordering::Amd => SymmetricOrdering::Amd,
+            };
+            let s =
+                factorize_symbolic_cholesky(symbolic, Side::Lower, ordering, Default::default())
+                    .map_err(|e| LinearError::SymbolicCholesky(format!("{e:?}")))?;
+            let req = s.solve_in_place_scratch::<f64>(1, par);
+            (Some(s), None, MemBuffer::new(req))
+        }
+        Solver::Direct | Solver::Auto => {
+            let s = factorize_symbolic_lu(symbolic, Default::default())
+                .map_err(|e| LinearError::SymbolicLu(format!("{e:?}")))?;
+            let req = s
+                .solve_in_place_scratch::<f64>(1, par)
+                .or(s.solve_transpose_in_place_scratch::<f64>(1, par));
+            (None, Some(s), MemBuffer::new(req))
+        }
+    })
+}
+
+/// One factorisation of `cM + A`.
+pub(super) enum Factor {
+    Llt(Vec<f64>),
+    Lu(Box<NumericLu<usize, f64>>),
+}
+
+/// Initial guess of a conjugate-gradient solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Guess {
+    Zero,
+    U,
+    /// Already in the first CG buffer.
+    Preset,
+}
+
+/// Coefficients whose CG time is remembered by [`Solver::Auto`].
+pub(super) const RENT_SLOTS: usize = 64;
+/// Before any factorisation is timed, [`Solver::Auto`] estimates one as this many CG
+/// iterations times nnz(L)/nnz(A) (measured: crack plate 1.0 s ≈ 17, thermal shock 6.9 s ≈ 9).
+pub(super) const FACTOR_PER_FILL: f64 = 15.0;
+
+impl Implicit<'_> {
+    /// Makes sure a factorisation of `cM + A` is cached; returns its slot.
+    pub(super) fn factor(&mut self, c: f64) -> Result<usize> {
+        if let Some(p) = self.factors.iter().position(|(k, _)| Self::same(*k, c)) {
+            return Ok(p);
+        }
+        let started = Instant::now();
+        let sys = &self.sys;
+        self.b_vals.copy_from_slice(&sys.vals);
+        for (r, &p) in sys.diag_pos.iter().enumerate() {
+            self.b_vals[p] += c * sys.mass[r];
+        }
+        let n = sys.len();
+        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
+        let b = SparseColMatRef::new(symbolic, &self.b_vals);
+        let factor = if let Some(s) = &self.chol {
+            let mut values = vec![0.0; s.len_val()];
+            let req = s.factorize_numeric_llt_scratch::<f64>(self.par, Default::default());
+            let mut mem = MemBuffer::new(req);
+            s.factorize_numeric_llt(
+                &mut values,
+                b,
+                Side::Lower,
+                LltRegularization::default(),
+                self.par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| LinearError::Cholesky {
+                c,
+                detail: format!("{e:?}"),
+            })?;
+            Factor::Llt(values)
+        } else if let Some(s) = &self.lu {
+            let mut numeric = NumericLu::<usize, f64>::new();
+            let req = s.factorize_numeric_lu_scratch::<f64>(self.par, Default::default());
+            let mut mem = MemBuffer::new(req);
+            s.factorize_numeric_lu(
+                &mut numeric,
+                b,
+                self.par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| LinearError::Lu {
+                c,
+                detail: format!("{e:?}"),
+            })?;
+            Factor::Lu(Box::new(numeric))
+        } else {
+            return Err(LinearError::NoSymbolic.into());
+        };
+        if self.factors.len() == 2 {
+            self.factors.remove(0);
+        }
+        self.factors.push((c, factor));
+        self.stats.factorisations += 1;
+        self.last_factor_seconds = started.elapsed().as_secs_f64();
+        self.stats.factor_seconds += self.last_factor_seconds;
+        Ok(self.factors.len() - 1)
+    }
+
+    /// True when `c` matches `k` to 1e-12 relative.
+    pub(super) fn same(k: f64, c: f64) -> bool {
+        (k - c).abs() <= 1e-12 * c.abs().max(f64::MIN_POSITIVE)
+    }
+
+    /// [`Solver::Auto`]: solve with CG while the seconds its solves on `c` took beyond a direct
+    /// solve (the last one timed; 0 before any) are below the cost of one factorisation, then
+    /// factorise (the ski-rental rule: at most twice the cheaper choice's cost). The cost is
+    /// the last factorisation's time; before any, CG iterations scaled by the factor's fill
+    /// ([`FACTOR_PER_FILL`]). So CG stays wherever it is cheaper per solve than the factor.
+    pub(super) fn use_cg(&self, c: f64) -> bool {
+        match self.options.solver {
+            Solver::Cg => true,
+            Solver::Direct => false,
+            Solver::Auto => {
+                let Some(chol) = &self.chol else {
+                    return false;
+                };
+                if self.factors.iter().any(|(k, _)| Self::same(*k, c)) {
+                    return false;
+                }
+                let spent = self
+                    .rent
+                    .iter()
+                    .find(|(k, _)| Self::same(*k, c))
+                    .map_or(0.0, |r| r.1);
+                let cost = if self.last_factor_seconds > 0.0 {
+                    self.last_factor_seconds
+                } else if self.stats.cg_iterations > 0 {
+                    let per_iteration = self.cg_seconds / self.stats.cg_iterations as f64;
+                    let fill = chol.len_val() as f64 / self.sys.vals.len() as f64;
+                    FACTOR_PER_FILL * fill * per_iteration
+                } else {
+                    f64::INFINITY
+                };
+                spent < cost
+            }
+        }
+    }
+
+    /// Adds what a CG solve on coefficient c cost beyond a direct solve ([`Solver::Auto`]).
+    pub(super) fn pay_rent(&mut self, c: f64, seconds: f64) {
+        self.cg_seconds += seconds;
+        let seconds = (seconds - self.direct_seconds).max(0.0);
+        if let Some(r) = self.rent.iter_mut().find(|(k, _)| Self::same(*k, c)) {
+            r.1 += seconds;
+            return;
+        }
+        if self.rent.len() == RENT_SLOTS {
+            self.rent.remove(0);
+        }
+        self.rent.push((c, seconds));
+    }
+
+    /// Solves `(cM + A) x = rhs`: the answer replaces `rhs`; `guess` starts CG.
+    pub(super) fn solve(&mut self, c: f64, guess: Guess) -> Result<()> {
+        if self.use_cg(c) {
+            let started = Instant::now();
+            let its = self.pcg(c, guess)?;
+            let seconds = started.elapsed().as_secs_f64();
+            self.pay_rent(c, seconds);
+            self.stats.cg_iterations += its;
+            self.stats.cg_solves += 1;
+            self.stats.solves += 1;
+            self.stats.solve_seconds += seconds;
+            return Ok(());
+        }
+        let slot = self.factor(c)?;
+        let started = Instant::now();
+        let n = self.sys.len();
+        match &self.factors[slot].1 {
+            Factor::Llt(values) => {
+                let s = self
+                    .chol
+                    .as_ref()
+                    .expect("Cholesky symbolic with its factor");
+                LltRef::new(s, values).solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1),
+                    self.par,
+                    MemStack::new(&mut self.stack),
+                );
+            }
+            Factor::Lu(numeric) => {
+                let s = self.lu.as_ref().expect("LU symbolic with its factor");
+                // the CSR arrays of A are the CSC arrays of Aᵀ: solve with the transpose
+                LuRef::new_unchecked(s, numeric).solve_transpose_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1),
+                    self.par,
+                    MemStack::new(&mut self.stack),
+                );
+            }
+        }
+        self.stats.solves += 1;
+        self.direct_seconds = started.elapsed().as_secs_f64();
+        self.stats.solve_seconds += self.direct_seconds;
+        Ok(())
+    }
+
+    /// Jacobi-preconditioned CG on `(cM + A) x = rhs`; x replaces `rhs`. Returns iterations.
+    pub(super) fn pcg(&mut self, c: f64, guess: Guess) -> Result<u64> {
+        let sys = &self.sys;
+        let par = self.options.parallel;
+        let [x, r, z, p] = &mut self.cg;
+        match guess {
+            Guess::U => x.copy_from_slice(&self.u),
+            Guess::Zero => x.fill(0.0),
+            Guess::Preset => {}
+        }
+        // r = b − B x, with B = cM + A = −(−c M − A)
+        sys.combine(-c, 1.0, x, r, par);
+        for (ri, bi) in r.iter_mut().zip(&self.rhs) {
+            *ri += bi;
+        }
+        let bnorm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // relative residual, or (adaptive runs) ‖r‖₂ ≤ e·c·min M, which bounds the error
+        // ‖x − x*‖₂ ≤ ‖r‖₂/λ_min(cM + A) ≤ e since A is positive semi-definite
+        let tol = (self.options.cg_tolerance * bnorm.max(f64::MIN_POSITIVE))
+            .max(self.cg_error * c * self.min_mass);
+        let diag = |k: usize| sys.vals[sys.diag_pos[k]] + c * sys.mass[k];
+        for (k, (zi, ri)) in z.iter_mut().zip(r.iter()).enumerate() {
+            *zi = ri / diag(k);
+        }
+        p.copy_from_slice(z);
+        let mut rz: f64 = r.iter().zip(z.iter()).map(|(a, b)| a * b).sum();
+        let mut its = 0u64;
+        let q = &mut self.rhs;
+        while r.iter().map(|v| v * v).sum::<f64>().sqrt() > tol {
+            if its >= 20_000 {
+                return Err(LinearError::CgDiverged { iterations: its }.into());
+            }
+            sys.combine(-c, 1.0, p, q, par);
+            for v in q.iter_mut() {
+                *v = -*v;
+            }
+            let pq: f64 = p.iter().zip(q.iter()).map(|(a, b)| a * b).sum();
+            let alpha = rz / pq;
+            for k in 0..x.len() {
+                x[k] += alpha * p[k];
+                r[k] -= alpha * q[k];
+                z[k] = r[k] / diag(k);
+            }
+            let rz_new: f64 = r.iter().zip(z.iter()).map(|(a, b)| a * b).sum();
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for k in 0..p.len() {
+                p[k] = z[k] + beta * p[k];
+            }
+            its += 1;
+        }
+        self.rhs.copy_from_slice(x);
+        Ok(its)
+    }
+}

@@ -1,0 +1,38 @@
+//! The steady solve `A θ = f(t)` at each output time (theory §4).
+
+use super::linear::Guess;
+use super::{refuse, Implicit};
+use crate::error::Result;
+use crate::operator::Conductance;
+use crate::solve::stepper::RunStats;
+
+impl Implicit<'_> {
+    /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
+    /// `on_output(k, t, θ, K)` for each (theory §4).
+    pub fn steady(
+        &mut self,
+        theta: &mut [f64],
+        outputs: &[f64],
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
+    ) -> Result<RunStats> {
+        if self.sys.is_floating() {
+            return Err(refuse(
+                "steady: no boundary condition fixes the temperature level (every face insulated or free, no temperature or convection condition); the steady state is not unique",
+            ));
+        }
+        for (k, &t) in outputs.iter().enumerate() {
+            self.sys.forcing(
+                self.model,
+                t,
+                &mut self.scratch,
+                &mut self.rate,
+                &mut self.rhs,
+            );
+            self.solve(0.0, Guess::Zero)?;
+            std::mem::swap(&mut self.u, &mut self.rhs);
+            self.scatter(theta, t)?;
+            on_output(k, t, theta, &self.model.conductance)?;
+        }
+        Ok(RunStats::default())
+    }
+}

@@ -1,0 +1,159 @@
+//! The time integrators of `time.integrator` (theory §4): their names, stability bounds and
+//! the step a run takes, and the implicit scheme each implicit integrator runs.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::solve::implicit::Scheme;
+use serde::{Deserialize, Serialize};
+
+/// Time integrator of `time.integrator`: the explicit ones in [`crate::solve::explicit`] (or,
+/// with phase change, [`crate::solve::enthalpy`]), the implicit ones and the steady solve in
+/// [`crate::solve::implicit`] (theory §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Forward Euler, stable for Δt ≤ 2/λ_max.
+    Euler,
+    /// Classical fourth-order Runge–Kutta, stable for Δt ≤ 2.78/λ_max.
+    Rk4,
+    /// Backward Euler (implicit, first order, no stability bound).
+    BackwardEuler,
+    /// Crank–Nicolson (implicit, second order, no stability bound).
+    CrankNicolson,
+    /// BDF2 (implicit, second order, no stability bound).
+    Bdf2,
+    /// Steady state A θ = f(t) at each output time (no time stepping).
+    Steady,
+}
+
+impl Integrator {
+    /// Every integrator, in the order their names are listed to users.
+    pub const ALL: [Integrator; 6] = [
+        Integrator::Euler,
+        Integrator::Rk4,
+        Integrator::BackwardEuler,
+        Integrator::CrankNicolson,
+        Integrator::Bdf2,
+        Integrator::Steady,
+    ];
+
+    /// Name for messages (the `time.integrator` value).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Euler => "euler",
+            Integrator::Rk4 => "rk4",
+            Integrator::BackwardEuler => "backward_euler",
+            Integrator::CrankNicolson => "crank_nicolson",
+            Integrator::Bdf2 => "bdf2",
+            Integrator::Steady => "steady",
+        }
+    }
+
+    /// The integrator of [`Integrator::name`] `name`, if there is one.
+    pub fn from_name(name: &str) -> Option<Integrator> {
+        Integrator::ALL.into_iter().find(|i| i.name() == name)
+    }
+
+    /// True for the implicit schemes and the steady solve ([`crate::solve::implicit`]).
+    pub fn is_implicit(&self) -> bool {
+        !matches!(self, Integrator::Euler | Integrator::Rk4)
+    }
+
+    /// The implicit scheme that runs this integrator (the steady solve uses the system and
+    /// solvers of BDF2's set-up); None for the explicit integrators. The one place the
+    /// implicit [`Scheme`] is derived from the integrator.
+    pub fn scheme(&self) -> Option<Scheme> {
+        match self {
+            Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
+            Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
+            Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
+            Integrator::Euler | Integrator::Rk4 => None,
+        }
+    }
+
+    /// Stability-region extent on the negative real axis (theory §4); infinite for the
+    /// implicit schemes (A-stable).
+    pub fn stability(&self) -> f64 {
+        match self {
+            Integrator::Euler => 2.0,
+            Integrator::Rk4 => 2.78,
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// Largest stable step for a model, s.
+    pub fn stable_dt(&self, model: &Model) -> f64 {
+        let l = model.lambda_max();
+        if l > 0.0 {
+            self.stability() / l
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// Chooses the step, s: the user's (checked against the bound) or 0.95 of the bound; implicit
+/// integrators need the user's step (no bound), the steady solve none (infinite).
+pub fn choose_dt(model: &Model, integrator: Integrator, user: Option<f64>) -> Result<f64> {
+    if integrator == Integrator::Steady {
+        return Ok(f64::INFINITY);
+    }
+    if integrator.is_implicit() {
+        return match user {
+            Some(dt) => Ok(dt),
+            None => Err(Error::model(
+                "time.dt",
+                format!(
+                    "is required for the implicit integrator {} (no stability bound to default to), unless time.tolerance asks for adaptive steps",
+                    integrator.name()
+                ),
+            )),
+        };
+    }
+    let bound = integrator.stable_dt(model);
+    match user {
+        Some(dt) if dt > bound => Err(Error::UnstableDt {
+            dt,
+            bound,
+            integrator: integrator.name(),
+        }),
+        Some(dt) => Ok(dt),
+        None if bound.is_finite() => Ok(0.95 * bound),
+        None => Err(Error::model(
+            "time.dt",
+            "every node is driven; give time.dt explicitly",
+        )),
+    }
+}
+
+/// Steps from `t` to `to` (s) when no step may exceed `dt` (s); a relative 1e-12 slack keeps
+/// round-off from adding a step.
+pub fn steps_between(t: f64, to: f64, dt: f64) -> u64 {
+    ((to - t) / dt * (1.0 - 1e-12)).ceil().max(0.0) as u64
+}
+
+/// Number of steps from `t0` to each output time (s) with steps no longer than `dt` (s).
+pub fn count_steps(t0: f64, outputs: &[f64], dt: f64) -> u64 {
+    let mut t = t0;
+    let mut n = 0;
+    for &to in outputs {
+        n += steps_between(t, to, dt);
+        t = to;
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for i in Integrator::ALL {
+            assert_eq!(Integrator::from_name(i.name()), Some(i));
+        }
+        assert_eq!(Integrator::from_name("rk2"), None);
+        assert_eq!(Integrator::Steady.scheme(), Some(Scheme::Bdf2));
+        assert_eq!(Integrator::Rk4.scheme(), None);
+    }
+}

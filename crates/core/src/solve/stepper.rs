@@ -1,0 +1,247 @@
+//! The one stepping interface of the time integrators ([`Stepper`]), implemented by the
+//! explicit ([`Explicit`]), enthalpy ([`Enthalpic`]) and implicit ([`Implicit`]) steppers;
+//! [`Engine`], the stepper a case's integrator and model call for; and the loops over the
+//! output times ([`march`] for fixed steps, [`integrate`] for every [`Schedule`]).
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::operator::Conductance;
+use crate::solve::enthalpy::Enthalpic;
+use crate::solve::explicit::Explicit;
+use crate::solve::implicit::{self, Adaptive, Implicit, Solver};
+use crate::solve::integrator::{steps_between, Integrator};
+
+/// Summary of a run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunStats {
+    /// Time steps taken.
+    pub steps: u64,
+}
+
+/// A fixed-step time integrator: the state of every node in θ (°C), advanced step by step.
+///
+/// The explicit steppers keep θ current; the implicit one keeps its state in the unknowns and
+/// writes it into θ at [`Stepper::settle`].
+pub trait Stepper {
+    /// Number of body nodes (the entries of θ that are checked for NaN).
+    fn n_body(&self) -> usize;
+
+    /// Refuses a fixed step `dt` (s) the stepper cannot take (implicit: not positive and
+    /// finite); the explicit steppers take any step the plan chose.
+    fn check_dt(&self, dt: f64) -> Result<()> {
+        let _ = dt;
+        Ok(())
+    }
+
+    /// Takes the state from `theta` (every node, °C) at time `t` (s): the next step starts
+    /// afresh (implicit: a start-up step; phase change: enthalpies from θ; growing cracks:
+    /// the bonds cut by `t`).
+    fn begin(&mut self, theta: &mut [f64], t: f64);
+
+    /// One step of length `h` (s) from `t` to `t1` (s; `t + h` up to the round-off the caller
+    /// chooses, e.g. exactly an output time).
+    fn advance(&mut self, theta: &mut [f64], t: f64, t1: f64, h: f64) -> Result<()>;
+
+    /// Steps between two progress reports of [`march`] (implicit steps are slow: every one).
+    fn report_every(&self) -> u64 {
+        256
+    }
+
+    /// Fails with [`Error::NonFinite`] if θ holds a non-finite body temperature at `t` (s);
+    /// checked every 4096 steps. The implicit state is checked at [`Stepper::settle`] instead.
+    fn check(&self, theta: &[f64], t: f64) -> Result<()> {
+        check_finite(theta, self.n_body(), t)
+    }
+
+    /// Brings θ up to time `t` (s) after steps (implicit: the state into θ, constrained nodes
+    /// set; growing cracks: K cut) and fails if a body temperature is not finite.
+    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()>;
+
+    /// K as it is after [`Stepper::settle`] (growing cracks cut; with phase change, the
+    /// current conductivities), W/K.
+    fn conductance_now(&mut self) -> &Conductance;
+
+    /// Energy of the body in the state `theta`, J: Σ V_i ρc_i θ_i, or with phase change
+    /// Σ V_i H_i of the stepper once it has begun.
+    fn energy_now(&self, theta: &[f64]) -> f64;
+
+    /// Called by [`march`] at the end of a run with its counters.
+    fn finish(&mut self, stats: &RunStats) {
+        let _ = stats;
+    }
+}
+
+/// Fails with [`Error::NonFinite`] at the first body node of `theta` (of `nb`) that is not finite at time `t`, s.
+pub fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
+    match theta[..nb].iter().position(|v| !v.is_finite()) {
+        Some(node) => Err(Error::NonFinite { node, time: t }),
+        None => Ok(()),
+    }
+}
+
+/// The fixed-step time loop of every stepper: steps no longer than `dt` (s) that land on each
+/// output time (s), a NaN check every 4096 steps and at every output, where
+/// `at_output(stepper, k, t, θ)` is called; `progress(steps)` every
+/// [`Stepper::report_every`] steps and at the end. The caller has begun the stepper.
+pub fn march<S: Stepper + ?Sized>(
+    stepper: &mut S,
+    theta: &mut [f64],
+    t0: f64,
+    dt: f64,
+    outputs: &[f64],
+    mut at_output: impl FnMut(&mut S, usize, f64, &[f64]) -> Result<()>,
+    mut progress: impl FnMut(u64),
+) -> Result<RunStats> {
+    stepper.check_dt(dt)?;
+    let every = stepper.report_every();
+    let mut t = t0;
+    let mut stats = RunStats::default();
+    for (k, &to) in outputs.iter().enumerate() {
+        let n = steps_between(t, to, dt);
+        let h = if n > 0 { (to - t) / n as f64 } else { 0.0 };
+        for s in 0..n {
+            let tn = t + s as f64 * h;
+            let t1 = if s + 1 == n {
+                to
+            } else {
+                t + (s + 1) as f64 * h
+            };
+            stepper.advance(theta, tn, t1, h)?;
+            stats.steps += 1;
+            if stats.steps % every == 0 {
+                progress(stats.steps);
+            }
+            if stats.steps % 4096 == 0 {
+                stepper.check(theta, tn + h)?;
+            }
+        }
+        t = to;
+        stepper.settle(theta, t)?;
+        at_output(stepper, k, t, theta)?;
+    }
+    progress(stats.steps);
+    stepper.finish(&stats);
+    Ok(stats)
+}
+
+/// The stepper of a case: the one that its integrator and model call for.
+pub enum Engine<'a> {
+    /// Forward Euler or RK4 on a linear model.
+    Explicit(Explicit<'a>),
+    /// Forward Euler in enthalpy form (phase change).
+    Enthalpic(Enthalpic<'a>),
+    /// Backward Euler, Crank–Nicolson, BDF2 or the steady solve.
+    Implicit(Box<Implicit<'a>>),
+}
+
+impl<'a> Engine<'a> {
+    /// Chooses and sets up the stepper of `integrator` on `model`: the enthalpy form of
+    /// forward Euler for phase change (the axisymmetric phase-change paper,
+    /// doi:10.1007/s42102-022-00092-3, refusing other integrators), the implicit stepper
+    /// (system eliminated and factorised symbolically; `adaptive` steps visit several Δt, so
+    /// CG until a factorisation pays, [`Solver::Auto`]) or the explicit one.
+    pub fn new(model: &'a Model, integrator: Integrator, adaptive: bool) -> Result<Self> {
+        if model.enthalpy.is_some() {
+            return Ok(Engine::Enthalpic(Enthalpic::new(model, integrator)?));
+        }
+        let Some(scheme) = integrator.scheme() else {
+            return Ok(Engine::Explicit(Explicit::new(model, integrator)));
+        };
+        let options = implicit::Options {
+            solver: if adaptive {
+                Solver::Auto
+            } else {
+                Solver::Direct
+            },
+            ..implicit::Options::default()
+        };
+        let stepper = Implicit::new(model, scheme, options)?;
+        Ok(Engine::Implicit(Box::new(stepper)))
+    }
+
+    /// The stepper.
+    pub fn stepper(&mut self) -> &mut (dyn Stepper + 'a) {
+        match self {
+            Engine::Explicit(s) => s,
+            Engine::Enthalpic(s) => s,
+            Engine::Implicit(s) => s.as_mut(),
+        }
+    }
+
+    /// The stepper, read only.
+    pub fn stepper_ref(&self) -> &(dyn Stepper + 'a) {
+        match self {
+            Engine::Explicit(s) => s,
+            Engine::Enthalpic(s) => s,
+            Engine::Implicit(s) => s.as_ref(),
+        }
+    }
+
+    /// The implicit stepper, if this is one (its counters, adaptive steps, the steady solve).
+    pub fn implicit(&self) -> Option<&Implicit<'a>> {
+        match self {
+            Engine::Implicit(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+/// How a run steps through its output times.
+#[derive(Debug, Clone, Copy)]
+pub struct Schedule {
+    /// The fixed step, s (infinite for the steady solve; adaptive: the first step or 0).
+    pub dt: f64,
+    /// Adaptive steps of the implicit schemes (`time.tolerance`), if asked for.
+    pub adaptive: Option<Adaptive>,
+    /// The steady solve at each output time instead of steps.
+    pub steady: bool,
+}
+
+impl Schedule {
+    /// True for fixed steps of [`Schedule::dt`] (neither adaptive steps nor the steady solve).
+    pub fn is_fixed(&self) -> bool {
+        self.adaptive.is_none() && !self.steady
+    }
+}
+
+/// The time loop of a run from `theta` (every node, °C) at `t0` (s) through `outputs` (s):
+/// fixed steps through [`march`], or the implicit stepper's steady solve or adaptive steps.
+/// Calls `on_output(k, t, θ, K, E)` at each output (K in W/K, E the body's energy in J) and
+/// `progress(steps, t)` now and then (t in s).
+pub fn integrate(
+    engine: &mut Engine<'_>,
+    schedule: &Schedule,
+    theta: &mut [f64],
+    t0: f64,
+    outputs: &[f64],
+    mut on_output: impl FnMut(usize, f64, &[f64], &Conductance, f64) -> Result<()>,
+    mut progress: impl FnMut(u64, f64),
+) -> Result<RunStats> {
+    if let Engine::Implicit(im) = engine {
+        let model = im.model();
+        let mut linear = |k: usize, t: f64, th: &[f64], c: &Conductance| {
+            on_output(k, t, th, c, model.energy(th))
+        };
+        if schedule.steady {
+            return im.steady(theta, outputs, linear);
+        }
+        if let Some(a) = &schedule.adaptive {
+            return im.run_adaptive(theta, t0, a, outputs, &mut linear, progress);
+        }
+    }
+    let dt = schedule.dt;
+    let stepper = engine.stepper();
+    stepper.begin(theta, t0);
+    march(
+        stepper,
+        theta,
+        t0,
+        dt,
+        outputs,
+        |s, k, t, th| {
+            let e = s.energy_now(th);
+            on_output(k, t, th, s.conductance_now(), e)
+        },
+        |steps| progress(steps, steps as f64 * dt),
+    )
+}
