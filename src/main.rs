@@ -43,6 +43,10 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Set a key of the case before running, as KEY=VALUE (the keys and values of
+        /// `sweep --vary`, one value), e.g. `--set time.end=0.5`; repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<peritherm::sweep::Vary>,
     },
     /// Solve a case with the built-in classical FEM reference and write the same outputs as
     /// `run` (field_<k>.csv, field_<k>.vtu, run.json) into --out.
@@ -71,6 +75,17 @@ enum Command {
         /// Output directories of `peritherm run`.
         #[arg(required = true)]
         runs: Vec<PathBuf>,
+        /// Also write the table, the commit and machine it was measured on, and the checks a
+        /// rerun must pass, into this figure file (e.g. validation/accuracy.json).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// The command that measured the runs, recorded in the figure file.
+        #[arg(long, default_value = "peritherm table")]
+        command: String,
+        /// The table of the runs' fields (thermal energy and a hash of each field file) instead
+        /// of the accuracy against their references.
+        #[arg(long)]
+        fields: bool,
     },
     /// Compare the fields of a run with those of a reference run of the same body (e.g. a
     /// refined mesh against a uniform fine one), output time by output time.
@@ -203,8 +218,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             .context("--threads")?;
     }
     match cli.command {
-        Command::Run { case, out, quiet } => {
-            let case = Case::load(&case)?;
+        Command::Run {
+            case,
+            out,
+            quiet,
+            set,
+        } => {
+            let case = peritherm::sweep::load_with(&case, &set)?;
             let bar = ProgressBar::new(0);
             if quiet || !std::io::stderr().is_terminal() {
                 bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -295,13 +315,19 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             print_comparisons(&summary);
             Ok(())
         }
-        Command::Table { runs } => {
-            say!("{}", RunSummary::table_header());
-            for dir in runs {
-                for row in RunSummary::read(&dir)?.table_rows() {
-                    say!("{row}");
-                }
-            }
+        Command::Table {
+            runs,
+            json,
+            command,
+            fields,
+        } => {
+            use peritherm::figures::{table, TableKind};
+            let kind = if fields {
+                TableKind::Fields
+            } else {
+                TableKind::Accuracy
+            };
+            say!("{}", table(&runs, json.as_deref(), kind, &command)?);
             Ok(())
         }
         Command::Compare {

@@ -193,6 +193,7 @@ fn execute(
         reference: writer.comparisons,
         implicit: implicit.as_ref().map(|st| st.stats),
         history,
+        settings: case.settings.clone(),
         origin: Some(origin),
     };
     summary.write(out)?;

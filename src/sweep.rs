@@ -134,6 +134,27 @@ pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<
         .collect()
 }
 
+/// The case file `path` with some keys set (`peritherm run --set KEY=VALUE`, one value each).
+pub fn load_with(path: &Path, set: &[Vary]) -> Result<Case> {
+    if set.is_empty() {
+        return Case::load(path);
+    }
+    if let Some(v) = set.iter().find(|v| v.values.len() != 1) {
+        return Err(Error::Case {
+            file: path.to_path_buf(),
+            key: format!("--set {}", v.key),
+            message: "takes one value (`peritherm sweep --vary` takes several)".into(),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
+        file: path.to_path_buf(),
+        key: "-".into(),
+        message: format!("cannot read: {e}"),
+    })?;
+    let mut variants = variants(&text, path, "", set)?;
+    Ok(variants.remove(0).case)
+}
+
 /// `prefix` plus `last-key-segment=value` for each setting, made safe for a directory name.
 fn label(prefix: &str, settings: &[(String, String)]) -> String {
     let mut parts: Vec<String> = Vec::new();
