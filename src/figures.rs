@@ -4,7 +4,8 @@
 use crate::atomic::write_atomic;
 use crate::error::Result;
 use crate::output::RunSummary;
-use peritherm_post::figures::{accuracy, fields, Provenance};
+use crate::sweep::Row;
+use peritherm_post::figures::{accuracy, fields, Check, Figures, Provenance, REL_TOL_SOLVER};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -24,6 +25,11 @@ pub fn commit() -> String {
         },
         None => "unknown".into(),
     }
+}
+
+/// This machine and work tree now ([`Provenance::here`] with [`commit`]).
+pub fn provenance(threads: usize) -> Provenance {
+    Provenance::here(commit(), threads)
 }
 
 /// Which table `peritherm table` writes.
@@ -54,7 +60,7 @@ pub fn table(
     let name = json
         .and_then(Path::file_stem)
         .map_or("table".into(), |s| s.to_string_lossy().into_owned());
-    let provenance = Provenance::here(commit(), threads);
+    let provenance = provenance(threads);
     let figures = match kind {
         TableKind::Accuracy => accuracy(&name, command, provenance, &pairs),
         TableKind::Fields => fields(&name, command, provenance, &pairs),
@@ -65,5 +71,49 @@ pub fn table(
             Ok(figures.markdown())
         }
         None => Ok(figures.table()),
+    }
+}
+
+/// The figures of a sweep: its table and, when `args` can repeat it (a sweep against its cases'
+/// references or its first variant, not a run directory), a check of every measure of its
+/// sweep.json. Variants may be implicit or adaptive, so every measure has the solver's
+/// tolerance ([`REL_TOL_SOLVER`]).
+pub fn sweep_figures(
+    name: &str,
+    command: &str,
+    provenance: Provenance,
+    args: Option<Vec<String>>,
+    rows: &[Row],
+) -> Figures {
+    let (columns, cells) = crate::sweep::cells(rows);
+    let mut checks = Vec::new();
+    for (i, r) in rows.iter().enumerate().filter(|_| args.is_some()) {
+        let measures = [
+            ("max_abs", Some(r.max_abs)),
+            ("mean_abs", r.mean_abs),
+            ("eq13", r.eq13),
+            ("epsilon", r.epsilon),
+            ("l2_rel", r.l2_rel),
+        ];
+        for (key, value) in measures {
+            let Some(value) = value.filter(|v| *v != 0.0) else {
+                continue;
+            };
+            checks.push(Check::Measure {
+                args: args.clone().unwrap_or_default(),
+                file: "sweep.json".into(),
+                pointer: format!("/{i}/{key}"),
+                value,
+                rel_tol: REL_TOL_SOLVER,
+            });
+        }
+    }
+    Figures {
+        name: name.into(),
+        command: command.into(),
+        provenance,
+        columns,
+        rows: cells,
+        checks,
     }
 }

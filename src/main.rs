@@ -125,6 +125,13 @@ enum Command {
         /// Leave out the nodes within this distance (m) of a crack tip in field comparisons.
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
+        /// Also write the table, the commit and machine, and the checks a rerun must pass into
+        /// this figure file (e.g. validation/bar_delta.json).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// The command that measured the sweep, recorded in the figure file.
+        #[arg(long, default_value = "peritherm sweep")]
+        command: String,
     },
     /// Run cases and write reports: plots of PD against the reference along the probe lines,
     /// the error along them, temperature/damage/flux maps, report.md and index.html.
@@ -348,7 +355,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             out,
             against,
             exclude_tips,
-        } => sweep(&cases, &vary, &out, against, exclude_tips),
+            json,
+            command,
+        } => {
+            let figures = json.map(|path| (path, command));
+            sweep(&cases, &vary, &out, against, exclude_tips, figures)
+        }
         Command::Bench {
             quick,
             nodes,
@@ -548,8 +560,12 @@ fn sweep(
     out: &std::path::Path,
     against: Option<PathBuf>,
     exclude_tips: f64,
+    figures: Option<(PathBuf, String)>,
 ) -> anyhow::Result<()> {
     use peritherm::sweep;
+    let args = against
+        .is_none()
+        .then(|| sweep_args(cases, vary, exclude_tips));
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
     }
@@ -561,7 +577,31 @@ fn sweep(
     let (table, _) = sweep::write_study(&variants, &rows, out, &against)?;
     say!("{table}");
     say!("-> {}", out.join("sweep.md").display());
+    if let Some((path, command)) = figures {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy();
+        let provenance = peritherm::figures::provenance(rayon::current_num_threads());
+        let f = peritherm::figures::sweep_figures(&name, &command, provenance, args, &rows);
+        peritherm::atomic::write_atomic(&path, f.to_json().as_bytes())?;
+        say!("-> {}", path.display());
+    }
     Ok(())
+}
+
+/// The arguments of `peritherm sweep` that repeat a sweep (without `--out`).
+fn sweep_args(
+    cases: &[PathBuf],
+    vary: &[peritherm::sweep::Vary],
+    exclude_tips: f64,
+) -> Vec<String> {
+    let mut args = vec!["sweep".to_string()];
+    args.extend(cases.iter().map(|c| c.display().to_string()));
+    for v in vary {
+        args.extend(["--vary".into(), format!("{}={}", v.key, v.values.join(","))]);
+    }
+    if exclude_tips > 0.0 {
+        args.extend(["--exclude-tips".into(), exclude_tips.to_string()]);
+    }
+    args
 }
 
 /// `peritherm plot`: per output a temperature map (one colour range for all outputs, cracks as
