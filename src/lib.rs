@@ -28,6 +28,7 @@ pub use peritherm_post::{plot, report};
 
 pub mod bench;
 pub mod fem;
+pub mod figures;
 pub mod prepare;
 pub mod run;
 pub mod simulation;

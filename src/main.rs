@@ -43,6 +43,10 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Set a key of the case before running, as KEY=VALUE (the keys and values of
+        /// `sweep --vary`, one value), e.g. `--set time.end=0.5`; repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<peritherm::sweep::Vary>,
     },
     /// Solve a case with the built-in classical FEM reference and write the same outputs as
     /// `run` (field_<k>.csv, field_<k>.vtu, run.json) into --out.
@@ -71,6 +75,17 @@ enum Command {
         /// Output directories of `peritherm run`.
         #[arg(required = true)]
         runs: Vec<PathBuf>,
+        /// Also write the table, the commit and machine it was measured on, and the checks a
+        /// rerun must pass, into this figure file (e.g. validation/accuracy.json).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// The command that measured the runs, recorded in the figure file.
+        #[arg(long, default_value = "peritherm table")]
+        command: String,
+        /// The table of the runs' fields (thermal energy and a hash of each field file) instead
+        /// of the accuracy against their references.
+        #[arg(long)]
+        fields: bool,
     },
     /// Compare the fields of a run with those of a reference run of the same body (e.g. a
     /// refined mesh against a uniform fine one), output time by output time.
@@ -110,6 +125,13 @@ enum Command {
         /// Leave out the nodes within this distance (m) of a crack tip in field comparisons.
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
+        /// Also write the table, the commit and machine, and the checks a rerun must pass into
+        /// this figure file (e.g. validation/bar_delta.json).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// The command that measured the sweep, recorded in the figure file.
+        #[arg(long, default_value = "peritherm sweep")]
+        command: String,
     },
     /// Run cases and write reports: plots of PD against the reference along the probe lines,
     /// the error along them, temperature/damage/flux maps, report.md and index.html.
@@ -200,8 +222,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             .context("--threads")?;
     }
     match cli.command {
-        Command::Run { case, out, quiet } => {
-            let case = Case::load(&case)?;
+        Command::Run {
+            case,
+            out,
+            quiet,
+            set,
+        } => {
+            let case = peritherm::sweep::load_with(&case, &set)?;
             let bar = ProgressBar::new(0);
             if quiet || !std::io::stderr().is_terminal() {
                 bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -287,13 +314,19 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             print_comparisons(&summary);
             Ok(())
         }
-        Command::Table { runs } => {
-            say!("{}", RunSummary::table_header());
-            for dir in runs {
-                for row in RunSummary::read(&dir)?.table_rows() {
-                    say!("{row}");
-                }
-            }
+        Command::Table {
+            runs,
+            json,
+            command,
+            fields,
+        } => {
+            use peritherm::figures::{table, TableKind};
+            let kind = if fields {
+                TableKind::Fields
+            } else {
+                TableKind::Accuracy
+            };
+            say!("{}", table(&runs, json.as_deref(), kind, &command)?);
             Ok(())
         }
         Command::Compare {
@@ -314,7 +347,12 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             out,
             against,
             exclude_tips,
-        } => sweep(&cases, &vary, &out, against, exclude_tips),
+            json,
+            command,
+        } => {
+            let figures = json.map(|path| (path, command));
+            sweep(&cases, &vary, &out, against, exclude_tips, figures)
+        }
         Command::Bench {
             quick,
             nodes,
@@ -514,8 +552,12 @@ fn sweep(
     out: &std::path::Path,
     against: Option<PathBuf>,
     exclude_tips: f64,
+    figures: Option<(PathBuf, String)>,
 ) -> anyhow::Result<()> {
     use peritherm::sweep;
+    let args = against
+        .is_none()
+        .then(|| sweep_args(cases, vary, exclude_tips));
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
     }
@@ -527,7 +569,31 @@ fn sweep(
     let (table, _) = sweep::write_study(&variants, &rows, out, &against)?;
     say!("{table}");
     say!("-> {}", out.join("sweep.md").display());
+    if let Some((path, command)) = figures {
+        let name = path.file_stem().unwrap_or_default().to_string_lossy();
+        let provenance = peritherm::figures::provenance(rayon::current_num_threads());
+        let f = peritherm::figures::sweep_figures(&name, &command, provenance, args, &rows);
+        peritherm::atomic::write_atomic(&path, f.to_json().as_bytes())?;
+        say!("-> {}", path.display());
+    }
     Ok(())
+}
+
+/// The arguments of `peritherm sweep` that repeat a sweep (without `--out`).
+fn sweep_args(
+    cases: &[PathBuf],
+    vary: &[peritherm::sweep::Vary],
+    exclude_tips: f64,
+) -> Vec<String> {
+    let mut args = vec!["sweep".to_string()];
+    args.extend(cases.iter().map(|c| c.display().to_string()));
+    for v in vary {
+        args.extend(["--vary".into(), format!("{}={}", v.key, v.values.join(","))]);
+    }
+    if exclude_tips > 0.0 {
+        args.extend(["--exclude-tips".into(), exclude_tips.to_string()]);
+    }
+    args
 }
 
 /// `peritherm plot`: per output a temperature map (one colour range for all outputs, cracks as

@@ -202,6 +202,7 @@ fn summary(
         reference: writer.comparisons,
         implicit: implicit.map(|st| st.stats),
         history: None,
+        settings: case.settings.clone(),
         origin: None,
     }
 }

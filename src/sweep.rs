@@ -134,6 +134,27 @@ pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<
         .collect()
 }
 
+/// The case file `path` with some keys set (`peritherm run --set KEY=VALUE`, one value each).
+pub fn load_with(path: &Path, set: &[Vary]) -> Result<Case> {
+    if set.is_empty() {
+        return Case::load(path);
+    }
+    if let Some(v) = set.iter().find(|v| v.values.len() != 1) {
+        return Err(Error::Case {
+            file: path.to_path_buf(),
+            key: format!("--set {}", v.key),
+            message: "takes one value (`peritherm sweep --vary` takes several)".into(),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
+        file: path.to_path_buf(),
+        key: "-".into(),
+        message: format!("cannot read: {e}"),
+    })?;
+    let mut variants = variants(&text, path, "", set)?;
+    Ok(variants.remove(0).case)
+}
+
 /// `prefix` plus `last-key-segment=value` for each setting, made safe for a directory name.
 fn label(prefix: &str, settings: &[(String, String)]) -> String {
     let mut parts: Vec<String> = Vec::new();
@@ -300,45 +321,85 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// The Markdown table of a sweep.
-pub fn markdown(rows: &[Row]) -> String {
-    let keys: Vec<String> = rows
+/// The columns and cells of a sweep's table (the varied keys after the label).
+pub fn cells(rows: &[Row]) -> (Vec<String>, Vec<Vec<String>>) {
+    let keys = rows
         .first()
-        .map(|r| r.settings.iter().map(|(k, _)| k.clone()).collect())
-        .unwrap_or_default();
-    let mut s = String::from("| variant |");
-    for k in &keys {
-        s.push_str(&format!(" {k} |"));
-    }
-    s.push_str(" nodes | bonds | δ_min (m) | δ/Δ | h (m) | wall (s) | t (s) | max abs diff (°C) | mean abs diff (°C) | eq 13 | ε (eq 27) | rel. L2 | against |\n|---|");
-    for _ in &keys {
-        s.push_str("---|");
-    }
-    s.push_str("---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        .map(|r| r.settings.iter().map(|(k, _)| k.clone()));
+    let mut columns = vec!["variant".to_string()];
+    columns.extend(keys.into_iter().flatten());
+    columns.extend(
+        [
+            "nodes",
+            "bonds",
+            "δ_min (m)",
+            "δ/Δ",
+            "h (m)",
+            "wall (s)",
+            "t (s)",
+            "max abs diff (°C)",
+            "mean abs diff (°C)",
+            "eq 13",
+            "ε (eq 27)",
+            "rel. L2",
+            "against",
+        ]
+        .map(String::from),
+    );
     let opt = |v: Option<f64>| v.map(|x| format!("{x:.3e}")).unwrap_or_else(|| "-".into());
-    for r in rows {
-        s.push_str(&format!("| {} |", r.label));
-        for (_, v) in &r.settings {
-            s.push_str(&format!(" {v} |"));
-        }
-        s.push_str(&format!(
-            " {} | {} | {:.3e} | {:.3} | {:.3e} | {:.1} | {} | {:.3e} | {} | {} | {} | {} | {} |\n",
-            r.nodes,
-            r.bonds,
-            r.delta_min,
-            r.ratio,
-            r.h_mean,
-            r.wall_seconds,
-            r.time,
-            r.max_abs,
+    let row = |r: &Row| {
+        let mut c = vec![r.label.clone()];
+        c.extend(r.settings.iter().map(|(_, v)| v.clone()));
+        c.extend([
+            r.nodes.to_string(),
+            r.bonds.to_string(),
+            format!("{:.3e}", r.delta_min),
+            format!("{:.3}", r.ratio),
+            format!("{:.3e}", r.h_mean),
+            format!("{:.1}", r.wall_seconds),
+            r.time.to_string(),
+            format!("{:.3e}", r.max_abs),
             opt(r.mean_abs),
             opt(r.eq13),
             opt(r.epsilon),
             opt(r.l2_rel),
-            r.against
-        ));
+            r.against.clone(),
+        ]);
+        c
+    };
+    (columns, rows.iter().map(row).collect())
+}
+
+/// The Markdown table of a sweep.
+pub fn markdown(rows: &[Row]) -> String {
+    let (columns, cells) = cells(rows);
+    let mut s = format!(
+        "| {} |\n|{}\n",
+        columns.join(" | "),
+        "---|".repeat(columns.len())
+    );
+    for row in cells {
+        s.push_str(&format!("| {} |\n", row.join(" | ")));
     }
     s
+}
+
+/// The measures of a sweep's rows as JSON (sweep.json): per row its variant, time and the
+/// differences from what it was compared with (null where not measured).
+pub fn json(rows: &[Row]) -> String {
+    let row = |r: &Row| {
+        serde_json::json!({
+            "variant": r.label,
+            "time": r.time,
+            "max_abs": r.max_abs,
+            "mean_abs": r.mean_abs,
+            "eq13": r.eq13,
+            "epsilon": r.epsilon,
+            "l2_rel": r.l2_rel,
+        })
+    };
+    let rows: Vec<serde_json::Value> = rows.iter().map(row).collect();
+    serde_json::to_string_pretty(&rows).expect("plain data serialises") + "\n"
 }
 
 /// What the variants of a sweep are compared with.
@@ -776,8 +837,8 @@ pub fn study(
     Ok((all, against))
 }
 
-/// Writes a finished study into `out`: sweep.csv (one row per variant and output time) and
-/// sweep.md (the table, the fitted convergence rates and the plots, which it draws); returns
+/// Writes a finished study into `out`: sweep.csv (one row per variant and output time),
+/// sweep.json (its measures) and sweep.md (the table, the fitted convergence rates and the plots, which it draws); returns
 /// the Markdown and the CSV text.
 pub fn write_study(
     variants: &[Variant],
@@ -806,6 +867,7 @@ pub fn write_study(
     let csv = csv(rows);
     crate::atomic::write_atomic(&out.join("sweep.csv"), csv.as_bytes())?;
     crate::atomic::write_atomic(&out.join("sweep.md"), table.as_bytes())?;
+    crate::atomic::write_atomic(&out.join("sweep.json"), json(rows).as_bytes())?;
     Ok((table, csv))
 }
 

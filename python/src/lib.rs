@@ -700,6 +700,7 @@ fn write_recorded(
             reference: writer.comparisons,
             implicit: None,
             history: None,
+            settings: case.settings.clone(),
             origin: Some(origin),
         };
         summary.write(dir)?;

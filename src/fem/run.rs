@@ -201,6 +201,7 @@ fn solve(
         reference: comparisons,
         implicit: None,
         history: None,
+        settings: case.settings.clone(),
         origin: Some(origin),
     };
     summary.write(out)?;

@@ -14,6 +14,7 @@ mod common {
 
 mod bundled;
 mod cracks;
+mod figures;
 mod implicit;
 mod phase;
 mod symmetry;

@@ -14,6 +14,7 @@ mod common {
 }
 
 mod commands;
+mod figures;
 mod fuzz;
 mod hostile;
 mod plot;

@@ -502,6 +502,9 @@ pub struct Case {
     pub source: String,
     /// The other files the case reads (mesh, reference table, FEM mesh), resolved.
     pub inputs: Vec<PathBuf>,
+    /// Keys set on the command line over the file's (`run --set`, a sweep's variant), as
+    /// `KEY=VALUE`.
+    pub settings: Vec<String>,
 }
 
 impl Case {
@@ -1694,6 +1697,7 @@ impl CaseFile {
             history,
             source: String::new(),
             inputs: Vec::new(),
+            settings: Vec::new(),
         })
     }
 

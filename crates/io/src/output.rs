@@ -411,6 +411,10 @@ pub struct RunSummary {
     /// The `[history]` samples: their file and, per point, peaks and differences.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<crate::history::HistorySummary>,
+    /// Keys set on the command line over the case file's (`run --set`, a sweep's variant), as
+    /// `KEY=VALUE`: `peritherm run CASE --set KEY=VALUE ...` repeats the run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub settings: Vec<String>,
     /// Where the case came from ([`crate::provenance`]); absent in runs written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub origin: Option<CaseOrigin>,
@@ -512,38 +516,66 @@ impl RunSummary {
         Ok(rows)
     }
 
-    /// Markdown rows (one per output time) comparing this run with its reference.
-    pub fn table_rows(&self) -> Vec<String> {
+    /// Columns of the accuracy table ([`RunSummary::table_cells`]).
+    pub const TABLE_COLUMNS: [&'static str; 10] = [
+        "case",
+        "t (s)",
+        "nodes",
+        "max abs diff (°C)",
+        "eq 45",
+        "eq 13",
+        "probe PD / classical (°C)",
+        "bonds",
+        "steps",
+        "wall (s)",
+    ];
+
+    /// Cells of the accuracy table, one row per output time, comparing this run with its
+    /// reference.
+    pub fn table_cells(&self) -> Vec<Vec<String>> {
         let name = Path::new(&self.case)
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        self.reference
+        let row = |c: &Comparison| {
+            let probe = c
+                .probe
+                .as_ref()
+                .map(|p| format!("{:.3} / {:.3}", p.peridynamic, p.classical))
+                .unwrap_or_else(|| "-".into());
+            vec![
+                name.clone(),
+                number_label(c.time),
+                self.nodes.to_string(),
+                format!("{:.3e}", c.max_abs_diff),
+                format!("{:.3e}", c.mean_sq_rel_diff),
+                format!("{:.3e}", c.l2_rel_line),
+                probe,
+                self.bonds.to_string(),
+                self.steps.to_string(),
+                format!("{:.1}", self.wall_seconds),
+            ]
+        };
+        self.reference.iter().map(row).collect()
+    }
+
+    /// Markdown rows (one per output time) comparing this run with its reference.
+    pub fn table_rows(&self) -> Vec<String> {
+        let cells = self.table_cells();
+        cells
             .iter()
-            .map(|c| {
-                let probe = c
-                    .probe
-                    .as_ref()
-                    .map(|p| format!("{:.3} / {:.3}", p.peridynamic, p.classical))
-                    .unwrap_or_else(|| "-".into());
-                format!(
-                    "| {name} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {probe} | {} | {} | {:.1} |",
-                    number_label(c.time),
-                    self.nodes,
-                    c.max_abs_diff,
-                    c.mean_sq_rel_diff,
-                    c.l2_rel_line,
-                    self.bonds,
-                    self.steps,
-                    self.wall_seconds
-                )
-            })
+            .map(|r| format!("| {} |", r.join(" | ")))
             .collect()
     }
 
     /// Header of [`RunSummary::table_rows`].
-    pub fn table_header() -> &'static str {
-        "| case | t (s) | nodes | max abs diff (°C) | eq 45 | eq 13 | probe PD / classical (°C) | bonds | steps | wall (s) |\n|---|---|---|---|---|---|---|---|---|---|"
+    pub fn table_header() -> String {
+        let columns = Self::TABLE_COLUMNS;
+        format!(
+            "| {} |\n|{}",
+            columns.join(" | "),
+            "---|".repeat(columns.len())
+        )
     }
 
     /// Writes run.json atomically.

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 pub const CASE_COPY: &str = "case.toml";
 
 /// FNV-1a, 64 bits: enough to notice that a mesh file changed (not a cryptographic hash).
-fn fnv1a(bytes: &[u8]) -> u64 {
+pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
     })

@@ -5,5 +5,6 @@
 //! (`peritherm`: clap, indicatif, ctrlc, anyhow), and nothing below it depends on it.
 #![warn(missing_docs)]
 
+pub mod figures;
 pub mod plot;
 pub mod report;
