@@ -211,40 +211,6 @@ impl MeshGeometry {
         c
     }
 
-    /// A facet of `nodes` (file units) next to body cell `cell`, in metres, with its outward
-    /// normal (away from the cell's centre in `cell_centre`) and its area times τ.
-    fn facet(&self, nodes: &[u32], cell: u32, set: Option<u16>, cell_centre: &[Point]) -> Facet {
-        let s = self.scale;
-        let q: Vec<Point> = nodes.iter().map(|&n| self.mesh.nodes[n as usize]).collect();
-        let inside = cell_centre[cell as usize];
-        let mut n = match q.len() {
-            1 => Vector::x(),
-            2 => {
-                let t = q[1] - q[0];
-                Vector::new(t.y, -t.x, 0.0)
-            }
-            3 => (q[1] - q[0]).cross(&(q[2] - q[0])),
-            _ => (q[2] - q[0]).cross(&(q[3] - q[1])),
-        }
-        .normalize();
-        if (inside - q[0]).dot(&n) > 0.0 {
-            n = -n;
-        }
-        let (m, _) = measure_and_centroid(facet_kind(q.len()), &q);
-        let tau_area = match self.dim() {
-            1 => self.tau,
-            2 => m * s * self.tau,
-            _ => m * s * s,
-        };
-        Facet {
-            corners: q.iter().map(|p| Point::from(p.coords * s)).collect(),
-            normal: n,
-            area: tau_area,
-            cell,
-            set,
-        }
-    }
-
     /// Boundary facets (by topology) and the facets of every set, in metres.
     fn sides(&self, cells: &[&Element], new_of: &[u32], locate: &Locator) -> Result<MeshSides> {
         let mesh = &*self.mesh;
@@ -253,14 +219,17 @@ impl MeshGeometry {
         for (k, e) in cells.iter().enumerate() {
             cell_centre[new_of[k] as usize] = measure_and_centroid(e.kind, &mesh.corners(e)).1;
         }
-        let (mut sets, owner) = self.group_sets(&faces, &cell_centre)?;
+        let maker = FacetMaker {
+            geometry: self,
+            dim: self.dim(),
+            cell_centre: &cell_centre,
+        };
+        let (mut sets, owner) = self.group_sets(&faces, &maker)?;
         let s = self.scale;
         let mut boundary: Vec<Facet> = faces
             .iter()
             .filter(|(_, v)| v.2 == 1)
-            .map(|(k, (cell, nodes, _))| {
-                self.facet(nodes, *cell, owner.get(k).copied(), &cell_centre)
-            })
+            .map(|(k, (cell, nodes, _))| maker.make(nodes, *cell, owner.get(k).copied()))
             // a side facing another element is a non-conforming interface, not boundary
             .filter(|f| {
                 let inner = Point::from(cell_centre[f.cell as usize].coords * s);
@@ -299,7 +268,7 @@ impl MeshGeometry {
     fn group_sets(
         &self,
         faces: &FacetCounts,
-        cell_centre: &[Point],
+        maker: &FacetMaker,
     ) -> Result<(Vec<FacetSet>, HashMap<FaceKey, u16>)> {
         let mesh = &*self.mesh;
         let groups = self.set_groups();
@@ -320,11 +289,57 @@ impl MeshGeometry {
                     ));
                 };
                 owner.entry(key).or_insert(si as u16);
-                list.push(self.facet(&e.nodes, *cell, Some(si as u16), cell_centre));
+                list.push(maker.make(&e.nodes, *cell, Some(si as u16)));
             }
             sets.push(FacetSet::new(list));
         }
         Ok((sets, owner))
+    }
+}
+
+/// Makes the facets of a mesh geometry (the body's dimension found once: [`Mesh::dim`]
+/// scans the elements).
+struct FacetMaker<'a> {
+    geometry: &'a MeshGeometry,
+    dim: usize,
+    /// The centroid of every body cell by its body node index, file units.
+    cell_centre: &'a [Point],
+}
+
+impl FacetMaker<'_> {
+    /// A facet of `nodes` (file units) next to body cell `cell`, in metres, with its outward
+    /// normal (away from the cell's centre) and its area times τ.
+    fn make(&self, nodes: &[u32], cell: u32, set: Option<u16>) -> Facet {
+        let g = self.geometry;
+        let s = g.scale;
+        let q: Vec<Point> = nodes.iter().map(|&n| g.mesh.nodes[n as usize]).collect();
+        let inside = self.cell_centre[cell as usize];
+        let mut n = match q.len() {
+            1 => Vector::x(),
+            2 => {
+                let t = q[1] - q[0];
+                Vector::new(t.y, -t.x, 0.0)
+            }
+            3 => (q[1] - q[0]).cross(&(q[2] - q[0])),
+            _ => (q[2] - q[0]).cross(&(q[3] - q[1])),
+        }
+        .normalize();
+        if (inside - q[0]).dot(&n) > 0.0 {
+            n = -n;
+        }
+        let (m, _) = measure_and_centroid(facet_kind(q.len()), &q);
+        let tau_area = match self.dim {
+            1 => g.tau,
+            2 => m * s * g.tau,
+            _ => m * s * s,
+        };
+        Facet {
+            corners: q.iter().map(|p| Point::from(p.coords * s)).collect(),
+            normal: n,
+            area: tau_area,
+            cell,
+            set,
+        }
     }
 }
 
