@@ -362,97 +362,43 @@ pub fn peak_rss() -> Option<u64> {
 
 /// Runs the benchmark; `say` receives progress lines.
 pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport> {
-    let p1 = pool(1)?;
-    let pn = pool(opts.threads)?;
-    let (triad_len, reps) = if opts.quick {
-        (1 << 22, 5)
-    } else {
-        (1 << 26, 15)
+    let bench = Bench {
+        p1: pool(1)?,
+        pn: pool(opts.threads)?,
+        triad_len: if opts.quick { 1 << 22 } else { 1 << 26 },
+        step_reps: if opts.quick { 5 } else { 21 },
     };
-    say(&format!("triad, {} MB per array", (triad_len * 8) >> 20));
-    let mut triad = Triad::new(triad_len);
-    let triad_1 = triad.median_gbs(&p1, reps);
-    let triad_n = triad.median_gbs(&pn, reps);
+    let reps = if opts.quick { 5 } else { 15 };
+    say(&format!(
+        "triad, {} MB per array",
+        (bench.triad_len * 8) >> 20
+    ));
+    let mut triad = Triad::new(bench.triad_len);
+    let triad_1 = triad.median_gbs(&bench.p1, reps);
+    let triad_n = triad.median_gbs(&bench.pn, reps);
     // made again beside each model, so that it does not add to the build's peak memory
     drop(triad);
-    let configs: Vec<(String, usize, usize, f64)> = match opts.nodes {
-        Some(n) => {
-            let c = (n as f64).sqrt().round().max(4.0) as usize;
-            vec![("2D m = 3".into(), 2, c, 3.0)]
-        }
-        None if opts.quick => vec![
-            ("2D m = 3".into(), 2, 300, 3.0),
-            ("2D m = 6.5".into(), 2, 300, 6.5),
-            ("3D m = 3".into(), 3, 45, 3.0),
-        ],
-        None => vec![
-            ("2D m = 3".into(), 2, 1000, 3.0),
-            ("2D m = 6.5".into(), 2, 1000, 6.5),
-            ("3D m = 3".into(), 3, 100, 3.0),
-        ],
-    };
-    let step_reps = if opts.quick { 5 } else { 21 };
     let mut steps = Vec::new();
     let mut setup = Vec::new();
-    for (name, dim, cells, m) in configs {
+    for (name, dim, cells, m) in plate_configs(opts) {
         let case = plate(dim, cells, m)?;
         if setup.is_empty() {
             say(&format!("{name}: set-up"));
-            let mut s = Vec::new();
-            let mut w = Vec::new();
-            let mut a = Vec::new();
-            for _ in 0..if opts.quick || opts.nodes.is_some() {
+            let repeats = if opts.quick || opts.nodes.is_some() {
                 1
             } else {
                 3
-            } {
-                let [x, y, z] = time_setup(&pn, &case)?;
-                s.push(x);
-                w.push(y);
-                a.push(z);
-            }
-            let t = Instant::now();
-            let model = pn.install(|| Model::build(&case.spec))?;
-            let build = t.elapsed().as_secs_f64();
-            setup.push(SetupRow {
-                name: name.clone(),
-                nodes: model.cloud.n_body,
-                search: median(s),
-                weights: median(w),
-                assembly: median(a),
-                build,
-            });
-            drop(model);
+            };
+            setup.push(bench.setup_row(&name, &case, repeats)?);
         }
         say(&format!("{name}: build"));
-        let model = pn.install(|| Model::build(&case.spec))?;
+        let model = bench.pn.install(|| Model::build(&case.spec))?;
         say(&format!(
             "{name}: {} nodes, {} bonds: steps",
             model.cloud.n_body,
             model.conductance.nnz()
         ));
-        let nnz = model.conductance.nnz() as f64;
-        let mut triad = Triad::new(triad_len);
-        for (kernel, on) in [("CSR", false), ("stencils", true)] {
-            let (step_1, triad_1, used) = time_step(&p1, &model, step_reps, on, &mut triad);
-            let Some(held) = (if on { used } else { Some(0) }) else {
-                say(&format!("{name}: no stencils (rows do not repeat)"));
-                continue;
-            };
-            let (step_n, triad_n, _) = time_step(&pn, &model, step_reps, on, &mut triad);
-            steps.push(StepRow {
-                name: name.clone(),
-                kernel,
-                nodes: model.cloud.n_body,
-                bonds: model.conductance.nnz(),
-                step_1,
-                step_n,
-                triad_1,
-                triad_n,
-                bytes_per_bond: bond_bytes(&model) as f64 / nnz,
-                stencil_bytes_per_bond: held as f64 / nnz,
-            });
-        }
+        steps.extend(bench.step_rows(&name, &model, &mut say));
     }
     let cases = match &opts.cases {
         Some(dir) => time_cases(dir, &mut say)?,
@@ -469,11 +415,122 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
     })
 }
 
+/// The plates the benchmark times: (name, dimension, cells per side, m = δ/Δ).
+fn plate_configs(opts: &BenchOptions) -> Vec<(String, usize, usize, f64)> {
+    match opts.nodes {
+        Some(n) => {
+            let c = (n as f64).sqrt().round().max(4.0) as usize;
+            vec![("2D m = 3".into(), 2, c, 3.0)]
+        }
+        None if opts.quick => vec![
+            ("2D m = 3".into(), 2, 300, 3.0),
+            ("2D m = 6.5".into(), 2, 300, 6.5),
+            ("3D m = 3".into(), 3, 45, 3.0),
+        ],
+        None => vec![
+            ("2D m = 3".into(), 2, 1000, 3.0),
+            ("2D m = 6.5".into(), 2, 1000, 6.5),
+            ("3D m = 3".into(), 3, 100, 3.0),
+        ],
+    }
+}
+
+/// The thread pools and sizes of one benchmark run.
+struct Bench {
+    /// One worker thread.
+    p1: ThreadPool,
+    /// All the threads asked for.
+    pn: ThreadPool,
+    /// Length of each triad array (doubles).
+    triad_len: usize,
+    /// Repetitions of each timed step.
+    step_reps: usize,
+}
+
+impl Bench {
+    /// The set-up timings of `case` (medians of `repeats`) and the time of its whole model
+    /// build, all threads.
+    fn setup_row(&self, name: &str, case: &Case, repeats: usize) -> Result<SetupRow> {
+        let mut s = Vec::new();
+        let mut w = Vec::new();
+        let mut a = Vec::new();
+        for _ in 0..repeats {
+            let [x, y, z] = time_setup(&self.pn, case)?;
+            s.push(x);
+            w.push(y);
+            a.push(z);
+        }
+        let t = Instant::now();
+        let model = self.pn.install(|| Model::build(&case.spec))?;
+        let build = t.elapsed().as_secs_f64();
+        let row = SetupRow {
+            name: name.to_string(),
+            nodes: model.cloud.n_body,
+            search: median(s),
+            weights: median(w),
+            assembly: median(a),
+            build,
+        };
+        drop(model);
+        Ok(row)
+    }
+
+    /// The explicit step of `model` timed on one and on all threads, with the CSR kernel
+    /// and with stencils (when rows repeat), each beside a triad.
+    fn step_rows(&self, name: &str, model: &Model, say: &mut impl FnMut(&str)) -> Vec<StepRow> {
+        let nnz = model.conductance.nnz() as f64;
+        let mut triad = Triad::new(self.triad_len);
+        let mut rows = Vec::new();
+        for (kernel, on) in [("CSR", false), ("stencils", true)] {
+            let (step_1, triad_1, used) =
+                time_step(&self.p1, model, self.step_reps, on, &mut triad);
+            let Some(held) = (if on { used } else { Some(0) }) else {
+                say(&format!("{name}: no stencils (rows do not repeat)"));
+                continue;
+            };
+            let (step_n, triad_n, _) = time_step(&self.pn, model, self.step_reps, on, &mut triad);
+            rows.push(StepRow {
+                name: name.to_string(),
+                kernel,
+                nodes: model.cloud.n_body,
+                bonds: model.conductance.nnz(),
+                step_1,
+                step_n,
+                triad_1,
+                triad_n,
+                bytes_per_bond: bond_bytes(model) as f64 / nnz,
+                stencil_bytes_per_bond: held as f64 / nnz,
+            });
+        }
+        rows
+    }
+}
+
 impl BenchReport {
     /// The report as Markdown tables.
     pub fn markdown(&self) -> String {
+        let mut s = self.bandwidth_table();
+        s += &self.step_table();
+        s += &self.setup_table();
+        if !self.cases.is_empty() {
+            s += &self.cases_table();
+        }
+        if let Some(b) = self.peak_rss {
+            s += &format!("\nPeak resident set: {:.2} GB\n", b as f64 / 1e9);
+        }
+        s
+    }
+
+    /// The bond updates per second that a bandwidth of `gbs` GB/s allows at
+    /// [`BYTES_PER_BOND`].
+    fn bond_limit(gbs: f64) -> f64 {
+        gbs * 1e9 / BYTES_PER_BOND
+    }
+
+    /// The memory bandwidth table (triad on one and all threads).
+    fn bandwidth_table(&self) -> String {
         let n = self.threads;
-        let lim = |gbs: f64| gbs * 1e9 / BYTES_PER_BOND;
+        let lim = Self::bond_limit;
         let mut s = String::new();
         s += "| memory bandwidth (STREAM-like triad) | 1 thread | ";
         s += &format!("{n} threads |\n|---|---|---|\n");
@@ -484,7 +541,14 @@ impl BenchReport {
             lim(self.triad_1) / 1e9,
             lim(self.triad_n) / 1e9
         );
-        s += &format!(
+        s
+    }
+
+    /// The explicit step table: one row per plate and kernel.
+    fn step_table(&self) -> String {
+        let n = self.threads;
+        let lim = Self::bond_limit;
+        let mut s = format!(
             "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | triad alongside, 1 / {n} threads | of the 12 B/bond limit, 1 / {n} threads | B held per bond (+ stencils) |\n"
         );
         s += "|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -509,7 +573,12 @@ impl BenchReport {
                 r.stencil_bytes_per_bond
             );
         }
-        s += "\n| set-up | nodes | neighbour search | directed weights | assembly of K | search + weights + assembly | whole Model::build |\n|---|---|---|---|---|---|---|\n";
+        s
+    }
+
+    /// The set-up table: search, weights, assembly and the whole build.
+    fn setup_table(&self) -> String {
+        let mut s = String::from("\n| set-up | nodes | neighbour search | directed weights | assembly of K | search + weights + assembly | whole Model::build |\n|---|---|---|---|---|---|---|\n");
         for r in &self.setup {
             s += &format!(
                 "| {} | {} | {:.2} s | {:.2} s | {:.2} s | {:.2} s | {:.2} s |\n",
@@ -522,35 +591,35 @@ impl BenchReport {
                 r.build
             );
         }
-        if !self.cases.is_empty() {
-            s += "\n| case | integrator | K as | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|\n";
-            for r in &self.cases {
-                let errors: Vec<String> = r
-                    .errors
-                    .iter()
-                    .map(|(t, e)| format!("{e:.3e} at {t} s"))
-                    .collect();
-                let kas = match (r.integrator.as_str(), r.stencils) {
-                    ("euler", Some(f)) => format!("stencils ({:.1} % of the CSR bytes)", 100.0 * f),
-                    ("euler", None) => "CSR".to_string(),
-                    _ => "factorised".to_string(),
-                };
-                s += &format!(
-                    "| `{}` | {} | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
-                    r.case,
-                    r.integrator,
-                    kas,
-                    r.dt,
-                    r.steps,
-                    r.setup,
-                    r.integration,
-                    r.setup + r.integration,
-                    errors.join(", ")
-                );
-            }
-        }
-        if let Some(b) = self.peak_rss {
-            s += &format!("\nPeak resident set: {:.2} GB\n", b as f64 / 1e9);
+        s
+    }
+
+    /// The table of the timed cases (`--cases`).
+    fn cases_table(&self) -> String {
+        let mut s = String::from("\n| case | integrator | K as | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|\n");
+        for r in &self.cases {
+            let errors: Vec<String> = r
+                .errors
+                .iter()
+                .map(|(t, e)| format!("{e:.3e} at {t} s"))
+                .collect();
+            let kas = match (r.integrator.as_str(), r.stencils) {
+                ("euler", Some(f)) => format!("stencils ({:.1} % of the CSR bytes)", 100.0 * f),
+                ("euler", None) => "CSR".to_string(),
+                _ => "factorised".to_string(),
+            };
+            s += &format!(
+                "| `{}` | {} | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                r.case,
+                r.integrator,
+                kas,
+                r.dt,
+                r.steps,
+                r.setup,
+                r.integration,
+                r.setup + r.integration,
+                errors.join(", ")
+            );
         }
         s
     }

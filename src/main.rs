@@ -227,48 +227,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             out,
             quiet,
             set,
-        } => {
-            let case = peritherm::sweep::load_with(&case, &set)?;
-            let bar = ProgressBar::new(0);
-            if quiet || !std::io::stderr().is_terminal() {
-                bar.set_draw_target(ProgressDrawTarget::hidden());
-            }
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}",
-                )
-                .expect("valid template"),
-            );
-            let summary = run_case_with(&case, &out, &options, |done, total| {
-                bar.set_length(total);
-                bar.set_position(done);
-            })?;
-            bar.finish_and_clear();
-            say!(
-                "{}: {} nodes, {} bonds, {} steps of {:.3e} s in {:.2} s -> {}",
-                case.path.display(),
-                summary.nodes,
-                summary.bonds,
-                summary.steps,
-                summary.dt,
-                summary.wall_seconds,
-                out.display()
-            );
-            if let Some(st) = &summary.implicit {
-                say!(
-                    "  {} accepted and {} rejected steps ({:.3e} to {:.3e} s), {} solves ({} by CG), {} factorisations",
-                    st.accepted,
-                    st.rejected,
-                    st.min_step,
-                    st.max_step,
-                    st.solves,
-                    st.cg_solves,
-                    st.factorisations
-                );
-            }
-            print_comparisons(&summary);
-            Ok(())
-        }
+        } => run(&case, &set, &out, quiet, &options),
         Command::Fem {
             case,
             out,
@@ -277,42 +236,13 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             dt,
             quiet,
         } => {
-            let case = Case::load(&case)?;
-            let bar = ProgressBar::new(0);
-            if quiet || !std::io::stderr().is_terminal() {
-                bar.set_draw_target(ProgressDrawTarget::hidden());
-            }
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}",
-                )
-                .expect("valid template"),
-            );
             let opts = FemOptions {
                 h,
                 scheme,
                 dt,
                 mesh: None,
             };
-            let summary = run_fem(&case, &out, &opts, |done, total| {
-                bar.set_length(total);
-                bar.set_position(done);
-            })?;
-            bar.finish_and_clear();
-            say!(
-                "{}: FEM, {} nodes, {} matrix entries, {} {} steps of {:.3e} s in {:.2} s (set-up {:.2} s) -> {}",
-                case.path.display(),
-                summary.nodes,
-                summary.pairs,
-                summary.steps,
-                summary.integrator,
-                summary.dt,
-                summary.wall_seconds,
-                summary.setup_seconds,
-                out.display()
-            );
-            print_comparisons(&summary);
-            Ok(())
+            fem(&case, &out, &opts, quiet)
         }
         Command::Table {
             runs,
@@ -371,6 +301,92 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Check { case } => check(&case, &options),
     }
+}
+
+/// The progress bar of `run` and `fem` (steps done of all), hidden when `quiet` or when
+/// stderr is not a terminal.
+fn step_bar(quiet: bool) -> ProgressBar {
+    let bar = ProgressBar::new(0);
+    if quiet || !std::io::stderr().is_terminal() {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {elapsed_precise} eta {eta}")
+            .expect("valid template"),
+    );
+    bar
+}
+
+/// `peritherm run`: runs the case into `out` and prints its sizes, time and comparisons.
+fn run(
+    path: &std::path::Path,
+    set: &[peritherm::sweep::Vary],
+    out: &std::path::Path,
+    quiet: bool,
+    options: &peritherm::prepare::Options,
+) -> anyhow::Result<()> {
+    let case = peritherm::sweep::load_with(path, set)?;
+    let bar = step_bar(quiet);
+    let summary = run_case_with(&case, out, options, |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    say!(
+        "{}: {} nodes, {} bonds, {} steps of {:.3e} s in {:.2} s -> {}",
+        case.path.display(),
+        summary.nodes,
+        summary.bonds,
+        summary.steps,
+        summary.dt,
+        summary.wall_seconds,
+        out.display()
+    );
+    if let Some(st) = &summary.implicit {
+        say!(
+            "  {} accepted and {} rejected steps ({:.3e} to {:.3e} s), {} solves ({} by CG), {} factorisations",
+            st.accepted,
+            st.rejected,
+            st.min_step,
+            st.max_step,
+            st.solves,
+            st.cg_solves,
+            st.factorisations
+        );
+    }
+    print_comparisons(&summary);
+    Ok(())
+}
+
+/// `peritherm fem`: the classical FEM solve of the case into `out`, with its sizes, time
+/// and comparisons.
+fn fem(
+    path: &std::path::Path,
+    out: &std::path::Path,
+    opts: &FemOptions,
+    quiet: bool,
+) -> anyhow::Result<()> {
+    let case = Case::load(path)?;
+    let bar = step_bar(quiet);
+    let summary = run_fem(&case, out, opts, |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    say!(
+        "{}: FEM, {} nodes, {} matrix entries, {} {} steps of {:.3e} s in {:.2} s (set-up {:.2} s) -> {}",
+        case.path.display(),
+        summary.nodes,
+        summary.pairs,
+        summary.steps,
+        summary.integrator,
+        summary.dt,
+        summary.wall_seconds,
+        summary.setup_seconds,
+        out.display()
+    );
+    print_comparisons(&summary);
+    Ok(())
 }
 
 /// `peritherm check`: everything `run` does before its time loop (the budget, the model, the
@@ -463,11 +479,7 @@ fn compare(
     say!("| t (s) | max abs diff (°C) | mean abs diff (°C) | ε (eq 27) | where (m) |");
     say!("|---|---|---|---|---|");
     for (k, t) in a.output_times.iter().enumerate() {
-        let Some(kb) = b
-            .output_times
-            .iter()
-            .position(|tb| (tb - t).abs() <= 1e-9 * t.abs())
-        else {
+        let Some(kb) = b.output_index(*t) else {
             anyhow::bail!("{}: has no output at t = {t} s", reference.display());
         };
         let fa = a.read_field(run, k)?;

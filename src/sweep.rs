@@ -4,13 +4,14 @@
 //! the first variant.
 
 use crate::case::{Case, ReferenceSource};
+use crate::cloud::Cloud;
 use crate::crack::tips_at;
 use crate::error::{Error, Result};
 use crate::model::crack_cutters;
-use crate::output::RunSummary;
+use crate::output::{FieldRows, RunSummary};
 use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
 use crate::report::field_difference;
-use crate::report::page::probe_lines;
+use crate::report::page::{probe_lines, ProbeLine};
 use crate::run::run_case;
 use std::path::{Path, PathBuf};
 
@@ -426,9 +427,36 @@ pub fn run(
     let mut rows = Vec::new();
     for (k, v) in variants.iter().enumerate() {
         progress(k, &v.label);
-        let dir = out.join(&v.label);
-        // compared with another run, a variant's own [reference.fem] (solved again for every
-        // variant, the measures not using it) is left out
+        let done = VariantRun::run(v, out.join(&v.label), against)?;
+        let reference_dir = match against {
+            Against::Reference => {
+                rows.extend(done.reference_rows()?);
+                continue;
+            }
+            Against::Run(d) => d.clone(),
+            Against::First => out.join(&variants[0].label),
+        };
+        rows.extend(done.field_rows(&reference_dir, exclude_tips)?);
+    }
+    Ok(rows)
+}
+
+/// A variant that has run: its summary, its bare cloud and the columns that all its rows
+/// share.
+struct VariantRun<'a> {
+    variant: &'a Variant,
+    /// Its output directory.
+    dir: PathBuf,
+    summary: RunSummary,
+    cloud: Cloud,
+    /// Its row with the time and the measures left blank.
+    base: Row,
+}
+
+impl<'a> VariantRun<'a> {
+    /// Runs `v` into `dir`; compared with another run, a variant's own [reference.fem]
+    /// (solved again for every variant, the measures not using it) is left out.
+    fn run(v: &'a Variant, dir: PathBuf, against: &Against) -> Result<VariantRun<'a>> {
         let own_fem = v
             .case
             .reference
@@ -465,49 +493,60 @@ pub fn run(
             l2_rel: None,
             against: String::new(),
         };
-        let reference_dir = match against {
-            Against::Reference => {
-                if summary.reference.is_empty() {
-                    return Err(Error::Case {
-                        file: v.case.path.clone(),
-                        key: "reference".into(),
-                        message:
-                            "the case has no [reference]; give the sweep a run to compare with"
-                                .into(),
-                    });
-                }
-                for c in &summary.reference {
-                    rows.push(Row {
-                        time: c.time,
-                        max_abs: c.max_abs_diff,
-                        eq13: Some(c.l2_rel_line),
-                        epsilon: Some(c.epsilon),
-                        l2_rel: Some(c.l2_rel_volume),
-                        against: "reference".into(),
-                        ..base.clone()
-                    });
-                }
-                continue;
-            }
-            Against::Run(d) => d.clone(),
-            Against::First => out.join(&variants[0].label),
-        };
-        let reference = RunSummary::read(&reference_dir)?;
-        let cracks = crack_cutters(&cloud, &v.case.spec.cracks);
+        Ok(VariantRun {
+            variant: v,
+            dir,
+            summary,
+            cloud,
+            base,
+        })
+    }
+
+    /// The rows of the comparisons with the variant's own `[reference]`; an error without one.
+    fn reference_rows(&self) -> Result<Vec<Row>> {
+        if self.summary.reference.is_empty() {
+            return Err(Error::Case {
+                file: self.variant.case.path.clone(),
+                key: "reference".into(),
+                message: "the case has no [reference]; give the sweep a run to compare with".into(),
+            });
+        }
+        Ok(self
+            .summary
+            .reference
+            .iter()
+            .map(|c| Row {
+                time: c.time,
+                max_abs: c.max_abs_diff,
+                eq13: Some(c.l2_rel_line),
+                epsilon: Some(c.epsilon),
+                l2_rel: Some(c.l2_rel_volume),
+                against: "reference".into(),
+                ..self.base.clone()
+            })
+            .collect())
+    }
+
+    /// The rows of the field-to-field comparisons with the run in `reference_dir` at every
+    /// output time, nodes within `exclude_tips` (m) of a crack tip left out.
+    fn field_rows(&self, reference_dir: &Path, exclude_tips: f64) -> Result<Vec<Row>> {
+        let (summary, cloud) = (&self.summary, &self.cloud);
+        let reference = RunSummary::read(reference_dir)?;
+        let cracks = crack_cutters(cloud, &self.variant.case.spec.cracks);
+        let mut rows = Vec::new();
         for (i, t) in summary.output_times.iter().enumerate() {
-            let Some(j) = reference
-                .output_times
-                .iter()
-                .position(|r| (r - t).abs() <= 1e-9 * t.abs())
-            else {
+            let Some(j) = reference.output_index(*t) else {
                 return Err(Error::Case {
                     file: reference_dir.join("run.json"),
                     key: "output_times".into(),
-                    message: format!("has no output at t = {t} s, which {} writes", v.label),
+                    message: format!(
+                        "has no output at t = {t} s, which {} writes",
+                        self.variant.label
+                    ),
                 });
             };
-            let a = summary.read_field(&dir, i)?;
-            let b = reference.read_field(&reference_dir, j)?;
+            let a = summary.read_field(&self.dir, i)?;
+            let b = reference.read_field(reference_dir, j)?;
             let tips = tips_at(&cracks, *t);
             let d = field_difference(
                 cloud.dim,
@@ -522,11 +561,11 @@ pub fn run(
                 mean_abs: Some(d.mean_abs),
                 epsilon: Some(d.epsilon()),
                 against: reference_dir.display().to_string(),
-                ..base.clone()
+                ..self.base.clone()
             });
         }
+        Ok(rows)
     }
-    Ok(rows)
 }
 
 /// The last component of `path` as text.
@@ -589,9 +628,7 @@ fn plot_axes(rows: &[Row]) -> Vec<(String, Axis)> {
 /// 2012 Figs 11–12). Returns the stems written and the fitted rates as (stem, series, rate).
 pub fn convergence_plots(rows: &[Row], out: &Path) -> Result<Vec<(String, String, f64)>> {
     let axes = plot_axes(rows);
-    let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
-    times.sort_by(f64::total_cmp);
-    times.dedup();
+    let times = output_times(rows);
     let mut fitted = Vec::new();
     for (name, x) in &axes {
         for (k, t) in times.iter().enumerate() {
@@ -683,122 +720,153 @@ pub fn line_plots(
     };
     let dim = first.case.spec.geometry.bare_cloud()?.dim;
     let mut stems = Vec::new();
-    let times: Vec<f64> = {
-        let mut t: Vec<f64> = rows.iter().map(|r| r.time).collect();
-        t.sort_by(f64::total_cmp);
-        t.dedup();
-        t
-    };
-    let reference_dir = match against {
-        Against::Run(d) => Some(d.clone()),
+    let reference_run = match against {
+        Against::Run(d) => Some((d.clone(), RunSummary::read(d)?)),
         _ => None,
     };
-    let reference_summary = match &reference_dir {
-        Some(d) => Some(RunSummary::read(d)?),
-        None => None,
-    };
-    for (k, t) in times.iter().enumerate() {
+    for (k, t) in output_times(rows).iter().enumerate() {
         let mut per_variant = Vec::new();
         for v in variants {
             let dir = out.join(&v.label);
             let s = RunSummary::read(&dir)?;
-            if let Some(i) = s
-                .output_times
-                .iter()
-                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
-            {
+            if let Some(i) = s.output_index(*t) {
                 per_variant.push((v, s.read_field(&dir, i)?));
             }
         }
         let Some((v0, f0)) = per_variant.first() else {
             continue;
         };
-        let reference = match (&reference_dir, &reference_summary) {
-            (Some(d), Some(s)) => s
-                .output_times
-                .iter()
-                .position(|x| (x - t).abs() <= 1e-9 * t.abs())
-                .map(|i| s.read_field(d, i))
-                .transpose()?,
-            _ => None,
+        let reference = match &reference_run {
+            Some((d, s)) => s.output_index(*t).map(|i| s.read_field(d, i)).transpose()?,
+            None => None,
+        };
+        let at = LinesAt {
+            per_variant: &per_variant,
+            reference: reference.as_ref(),
+            out,
+            k,
+            t: *t,
         };
         for line in probe_lines(&v0.case, f0, dim) {
-            let mut series = Vec::new();
-            let reference_points = match (&reference, &f0.reference) {
-                (Some(r), _) => Some(
-                    line.nodes(r)
-                        .iter()
-                        .map(|&(i, s)| (s, r.theta[i]))
-                        .collect::<Vec<_>>(),
-                ),
-                (None, Some(rv)) => Some(line.nodes(f0).iter().map(|&(i, s)| (s, rv[i])).collect()),
-                _ => None,
-            };
-            if let Some(p) = reference_points.filter(|p| !p.is_empty()) {
-                series.push(Series::new("reference", p).style(Style::Line).colour(7));
-            }
-            let mut diffs = Vec::new();
-            for (c, (v, f)) in per_variant.iter().enumerate() {
-                let colour = if c >= 7 { c + 1 } else { c };
-                if let Some(r) = &f.reference {
-                    let d: Vec<(f64, f64)> = line
-                        .nodes(f)
-                        .iter()
-                        .map(|&(i, s)| (s, f.theta[i] - r[i]))
-                        .collect();
-                    if !d.is_empty() {
-                        diffs.push(
-                            Series::new(v.label.clone(), d)
-                                .style(Style::LineMarkers)
-                                .colour(colour),
-                        );
-                    }
-                }
-                let p: Vec<(f64, f64)> = line
-                    .nodes(f)
-                    .iter()
-                    .map(|&(i, s)| (s, f.theta[i]))
-                    .collect();
-                if !p.is_empty() {
-                    series.push(
-                        Series::new(v.label.clone(), p)
-                            .style(Style::Markers)
-                            .colour(colour),
-                    );
-                }
-            }
-            if series.is_empty() {
-                continue;
-            }
-            if !diffs.is_empty() {
-                let stem = out.join(format!("differences_{}_t{}", line.slug(), k + 1));
-                line_plot(
-                    &stem,
-                    &Labels::new(
-                        format!("PD − reference along {} at t = {t} s", line.name),
-                        ["x (m)", "y (m)", "z (m)"][line.along],
-                        "Difference (°C)",
-                    ),
-                    &diffs,
-                    Legend::UpperLeft,
-                )?;
-                stems.push(file_name(&stem));
-            }
-            let stem = out.join(format!("lines_{}_t{}", line.slug(), k + 1));
+            stems.extend(at.draw(&line)?);
+        }
+    }
+    Ok(stems)
+}
+
+/// The distinct output times of the rows of a sweep, in increasing order, s.
+fn output_times(rows: &[Row]) -> Vec<f64> {
+    let mut times: Vec<f64> = rows.iter().map(|r| r.time).collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}
+
+/// The fields of a sweep's variants at one output time, for its line plots.
+struct LinesAt<'a> {
+    /// Every variant that has this output, with its field.
+    per_variant: &'a [(&'a Variant, FieldRows)],
+    /// The field of the run compared with at this time, if any.
+    reference: Option<&'a FieldRows>,
+    out: &'a Path,
+    /// Index of the output time (from 0).
+    k: usize,
+    /// The output time, s.
+    t: f64,
+}
+
+impl LinesAt<'_> {
+    /// Draws the temperatures (and the differences to each variant's reference, when there
+    /// are) along `line`; returns the stems written.
+    fn draw(&self, line: &ProbeLine) -> Result<Vec<String>> {
+        let (k, t) = (self.k, self.t);
+        let (series, diffs) = self.series(line);
+        if series.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut stems = Vec::new();
+        if !diffs.is_empty() {
+            let stem = self
+                .out
+                .join(format!("differences_{}_t{}", line.slug(), k + 1));
             line_plot(
                 &stem,
                 &Labels::new(
-                    format!("Temperature along {} at t = {t} s", line.name),
+                    format!("PD − reference along {} at t = {t} s", line.name),
                     ["x (m)", "y (m)", "z (m)"][line.along],
-                    "Temperature (°C)",
+                    "Difference (°C)",
                 ),
-                &series,
+                &diffs,
                 Legend::UpperLeft,
             )?;
             stems.push(file_name(&stem));
         }
+        let stem = self.out.join(format!("lines_{}_t{}", line.slug(), k + 1));
+        line_plot(
+            &stem,
+            &Labels::new(
+                format!("Temperature along {} at t = {t} s", line.name),
+                ["x (m)", "y (m)", "z (m)"][line.along],
+                "Temperature (°C)",
+            ),
+            &series,
+            Legend::UpperLeft,
+        )?;
+        stems.push(file_name(&stem));
+        Ok(stems)
     }
-    Ok(stems)
+
+    /// The temperature series along `line` (the reference first, then every variant) and
+    /// the PD − reference series of the variants that carry a reference.
+    fn series(&self, line: &ProbeLine) -> (Vec<Series>, Vec<Series>) {
+        let mut series = Vec::new();
+        let (_, f0) = &self.per_variant[0];
+        let reference_points = match (self.reference, &f0.reference) {
+            (Some(r), _) => Some(
+                line.nodes(r)
+                    .iter()
+                    .map(|&(i, s)| (s, r.theta[i]))
+                    .collect::<Vec<_>>(),
+            ),
+            (None, Some(rv)) => Some(line.nodes(f0).iter().map(|&(i, s)| (s, rv[i])).collect()),
+            _ => None,
+        };
+        if let Some(p) = reference_points.filter(|p| !p.is_empty()) {
+            series.push(Series::new("reference", p).style(Style::Line).colour(7));
+        }
+        let mut diffs = Vec::new();
+        for (c, (v, f)) in self.per_variant.iter().enumerate() {
+            // colour 7 is the reference's
+            let colour = if c >= 7 { c + 1 } else { c };
+            if let Some(r) = &f.reference {
+                let d: Vec<(f64, f64)> = line
+                    .nodes(f)
+                    .iter()
+                    .map(|&(i, s)| (s, f.theta[i] - r[i]))
+                    .collect();
+                if !d.is_empty() {
+                    diffs.push(
+                        Series::new(v.label.clone(), d)
+                            .style(Style::LineMarkers)
+                            .colour(colour),
+                    );
+                }
+            }
+            let p: Vec<(f64, f64)> = line
+                .nodes(f)
+                .iter()
+                .map(|&(i, s)| (s, f.theta[i]))
+                .collect();
+            if !p.is_empty() {
+                series.push(
+                    Series::new(v.label.clone(), p)
+                        .style(Style::Markers)
+                        .colour(colour),
+                );
+            }
+        }
+        (series, diffs)
+    }
 }
 
 /// The variants of a study and what they are compared with: every file of `cases` swept over

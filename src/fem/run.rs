@@ -6,12 +6,13 @@
 use super::problem::{budget, default_dt, steps_for, FemModel, FemOptions, FemProblem};
 use super::solve::{Scheme, Stepper};
 use crate::atomic::write_atomic;
-use crate::case::Case;
-use crate::case::ReferenceSource;
+use crate::case::{Case, ReferenceSource, ReferenceSpec};
+use crate::cloud::Cloud;
+use crate::crack::Cutter;
 use crate::error::{Error, Result};
 use crate::math::Vector;
 use crate::model::crack_cutters;
-use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, RunSummary};
+use crate::output::{field_csv, field_path, field_vtu, vtu_path, Comparison, Fields, RunSummary};
 use crate::report::{classical_at, compare};
 use std::path::Path;
 use std::time::Instant;
@@ -88,90 +89,45 @@ fn solve(
     opts: &FemOptions,
     dt: f64,
     t_setup: Instant,
-    mut progress: impl FnMut(u64, u64),
+    progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary> {
-    let mut stepper = Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme);
+    let mut clock = Clock {
+        case,
+        stepper: Stepper::new(&model.mesh, &model.system, &model.conditions, opts.scheme),
+        scheme: opts.scheme,
+        dt,
+        steps: 0,
+        total: total_steps(case, opts.scheme, dt),
+        progress,
+    };
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     let origin = crate::provenance::write_copy(out, case)?;
-    let total: u64 = match opts.scheme {
-        Scheme::Steady => case.outputs.len() as u64,
-        _ => {
-            let mut t = 0.0;
-            case.outputs
-                .iter()
-                .map(|&to| {
-                    let n = steps_for(to - t, dt);
-                    t = to;
-                    n
-                })
-                .sum()
-        }
-    };
-    // crack facets for interpolating a reference table without looking across a crack (the
-    // geometry's own boundary sets hold a mesh's crack groups)
-    // a case whose reference is this FEM solve has nothing to compare with here
-    let reference = case
-        .reference
-        .as_ref()
-        .filter(|r| !matches!(r.source, ReferenceSource::Fem(_)));
-    let cutters = match reference {
-        Some(_) if !case.spec.cracks.is_empty() => {
-            crack_cutters(&case.spec.geometry.bare_cloud()?, &case.spec.cracks)
-        }
-        _ => Vec::new(),
-    };
+    let mut reference = ReferenceCheck::of(case)?;
     let t_run = Instant::now();
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let mut flux = vec![Vector::zeros(); theta.len()];
     let damage = vec![0.0; theta.len()];
-    let (mut energy, mut fields, mut comparisons) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut reference_seconds, mut steps, mut t) = (0.0, 0u64, 0.0);
+    let (mut energy, mut fields, mut t) = (Vec::new(), Vec::new(), 0.0);
     for (k, &to) in case.outputs.iter().enumerate() {
-        if opts.scheme == Scheme::Steady {
-            stepper.steady(&mut theta, to).map_err(|e| keyed(case, e))?;
-            steps += 1;
-            progress(steps, total);
-        } else {
-            let n = steps_for(to - t, dt);
-            let h = (to - t) / n as f64;
-            for s in 0..n {
-                let now = if s + 1 == n { to - h } else { t + s as f64 * h };
-                stepper
-                    .step(&mut theta, now, h)
-                    .map_err(|e| keyed(case, e))?;
-                steps += 1;
-                progress(steps, total);
-            }
-        }
+        clock.advance(&mut theta, t, to)?;
         t = to;
         energy.push(model.energy(&theta));
         model.recovery.flux(&model.mesh, &theta, &mut flux);
-        let classical = match reference {
-            Some(r) => {
-                let started = Instant::now();
-                let classical = classical_at(&model.cloud, &r.source, to, &cutters)?;
-                let tips = crate::crack::tips_at(&cutters, to);
-                comparisons.push(compare(&model.cloud, &theta, &classical, r, to, &tips));
-                reference_seconds += started.elapsed().as_secs_f64();
-                Some(classical)
-            }
-            None => None,
-        };
+        let classical = reference
+            .as_mut()
+            .map(|r| r.compare(model, &theta, to))
+            .transpose()?;
         let f = Fields {
             theta: &theta,
             damage: &damage,
             flux: &flux,
             reference: classical.as_deref(),
         };
-        let path = field_path(out, k + 1);
-        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-        write_atomic(
-            &vtu_path(out, k + 1),
-            field_vtu(&model.cloud, &f).as_bytes(),
-        )?;
-        fields.push(format!("field_{}.csv", k + 1));
+        fields.push(write_field(out, k + 1, &model.cloud, &f)?);
     }
+    let (comparisons, reference_seconds) =
+        reference.map_or((Vec::new(), 0.0), |r| (r.comparisons, r.seconds));
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
@@ -181,7 +137,7 @@ fn solve(
         fictitious_nodes: 0,
         bonds: 0,
         pairs: model.system.cols.len(),
-        steps,
+        steps: clock.steps,
         dt: if opts.scheme == Scheme::Steady {
             0.0
         } else {
@@ -206,4 +162,120 @@ fn solve(
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// Writes `field_<k>.csv` and `field_<k>.vtu` of output `k` (from 1) into `out`; returns
+/// the CSV's name.
+fn write_field(out: &Path, k: usize, cloud: &Cloud, f: &Fields) -> Result<String> {
+    write_atomic(&field_path(out, k), field_csv(cloud, f).as_bytes())?;
+    write_atomic(&vtu_path(out, k), field_vtu(cloud, f).as_bytes())?;
+    Ok(format!("field_{k}.csv"))
+}
+
+/// The number of steps of a FEM run: one steady solve per output, or the steps of about
+/// `dt` (s) that end on every output time.
+fn total_steps(case: &Case, scheme: Scheme, dt: f64) -> u64 {
+    match scheme {
+        Scheme::Steady => case.outputs.len() as u64,
+        _ => {
+            let mut t = 0.0;
+            case.outputs
+                .iter()
+                .map(|&to| {
+                    let n = steps_for(to - t, dt);
+                    t = to;
+                    n
+                })
+                .sum()
+        }
+    }
+}
+
+/// The stepping of a FEM run, counting the steps for `progress(done, total)`.
+struct Clock<'a, P> {
+    case: &'a Case,
+    stepper: Stepper<'a>,
+    scheme: Scheme,
+    /// The step asked for, s.
+    dt: f64,
+    /// Steps done.
+    steps: u64,
+    /// Steps of the whole run.
+    total: u64,
+    progress: P,
+}
+
+impl<P: FnMut(u64, u64)> Clock<'_, P> {
+    /// Takes θ from time `t` to the output time `to` (s): the steady state at `to`, or equal
+    /// steps of at most `dt` that end on `to`.
+    fn advance(&mut self, theta: &mut [f64], t: f64, to: f64) -> Result<()> {
+        let case = self.case;
+        if self.scheme == Scheme::Steady {
+            self.stepper.steady(theta, to).map_err(|e| keyed(case, e))?;
+            self.steps += 1;
+            (self.progress)(self.steps, self.total);
+        } else {
+            let n = steps_for(to - t, self.dt);
+            let h = (to - t) / n as f64;
+            for s in 0..n {
+                let now = if s + 1 == n { to - h } else { t + s as f64 * h };
+                self.stepper
+                    .step(theta, now, h)
+                    .map_err(|e| keyed(case, e))?;
+                self.steps += 1;
+                (self.progress)(self.steps, self.total);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The comparison of a FEM run with the case's reference at every output time.
+struct ReferenceCheck<'a> {
+    reference: &'a ReferenceSpec,
+    /// Crack facets for interpolating a reference table without looking across a crack
+    /// (the geometry's own boundary sets hold a mesh's crack groups).
+    cutters: Vec<Cutter>,
+    /// The comparisons so far, one per output time.
+    comparisons: Vec<Comparison>,
+    /// Time spent evaluating and comparing, s.
+    seconds: f64,
+}
+
+impl<'a> ReferenceCheck<'a> {
+    /// The check of `case`'s reference; `None` without one, or when the reference is this
+    /// FEM solve (nothing to compare with here).
+    fn of(case: &'a Case) -> Result<Option<ReferenceCheck<'a>>> {
+        let reference = case
+            .reference
+            .as_ref()
+            .filter(|r| !matches!(r.source, ReferenceSource::Fem(_)));
+        let Some(reference) = reference else {
+            return Ok(None);
+        };
+        let cutters = if case.spec.cracks.is_empty() {
+            Vec::new()
+        } else {
+            crack_cutters(&case.spec.geometry.bare_cloud()?, &case.spec.cracks)
+        };
+        Ok(Some(ReferenceCheck {
+            reference,
+            cutters,
+            comparisons: Vec::new(),
+            seconds: 0.0,
+        }))
+    }
+
+    /// Compares θ at time `to` (s) with the reference and returns the reference's
+    /// temperatures at the nodes, °C.
+    fn compare(&mut self, model: &FemModel, theta: &[f64], to: f64) -> Result<Vec<f64>> {
+        let started = Instant::now();
+        let r = self.reference;
+        let classical = classical_at(&model.cloud, &r.source, to, &self.cutters)?;
+        let tips = crate::crack::tips_at(&self.cutters, to);
+        self.comparisons
+            .push(compare(&model.cloud, theta, &classical, r, to, &tips));
+        self.seconds += started.elapsed().as_secs_f64();
+        Ok(classical)
+    }
 }

@@ -363,6 +363,41 @@ pub fn neumann_front(r: &Reference, t: f64) -> Option<f64> {
 }
 
 impl Reference {
+    /// The gold film of `cases/laser_film.toml` (Wang, Oterkus & Oterkus §4.4, Qiu & Tien's
+    /// data): L = 20 nm, α = 1.26e-4 m²/s, ρc = 2.5e6 J/(m³·K), J0 = 13.4 J/m², R = 0.93,
+    /// l = 15.3 nm, t0 = 100 fs, a = 1.992; a worked example shared by the tests.
+    pub fn laser_film_example() -> Reference {
+        Reference::FilmLaserPulse {
+            x0: 0.0,
+            length: 2e-8,
+            diffusivity: 1.26e-4,
+            heat_capacity: 2.5e6,
+            fluence: 13.4,
+            reflectivity: 0.93,
+            depth: 15.3e-9,
+            duration: 100e-15,
+            shape: 1.992,
+        }
+    }
+
+    /// The 10 × 10 m plate of `cases/thermal_shock_split.toml` (Wang, Oterkus & Oterkus §4.5:
+    /// α = 1 m²/s, A = 5 K/s, r = 2 1/s) with its initial step at y = `split` m from `below` to
+    /// `above` °C; a worked example shared by the tests.
+    pub fn split_plate_example(split: f64, below: f64, above: f64) -> Reference {
+        Reference::PlatePulseSplit {
+            x0: -5.0,
+            y0: -5.0,
+            length: 10.0,
+            width: 10.0,
+            diffusivity: 1.0,
+            amplitude: 5.0,
+            rate: 2.0,
+            split,
+            below,
+            above,
+        }
+    }
+
     /// Which of x, y, z the solution varies with.
     pub fn depends_on(&self) -> [bool; 3] {
         match self {
@@ -495,29 +530,7 @@ impl Reference {
     /// The classical temperature at the point (x, y, z), m, and time t, s, °C.
     pub fn eval(&self, x: f64, y: f64, z: f64, t: f64) -> f64 {
         match *self {
-            Reference::FilmLaserPulse {
-                x0,
-                length,
-                diffusivity,
-                heat_capacity,
-                fluence,
-                reflectivity,
-                depth,
-                duration,
-                shape,
-            } => {
-                let pulse = LaserPulse {
-                    length,
-                    diffusivity,
-                    heat_capacity,
-                    fluence,
-                    reflectivity,
-                    depth,
-                    duration,
-                    shape,
-                };
-                pulse.eval((x - x0).clamp(0.0, length), t)
-            }
+            Reference::FilmLaserPulse { .. } => self.laser_film(x, t),
             Reference::PlatePulseSplit { .. } => {
                 let (pulse, fx) = self.split_factors_x(x, t);
                 pulse + fx * self.split_factor_y(y, t)
@@ -540,51 +553,8 @@ impl Reference {
                 edge,
                 initial,
             } => edge + (initial - edge) * disc(x.hypot(y), radius, a, t),
-            Reference::SphereFixedSurface {
-                radius: rs,
-                diffusivity: a,
-                surface,
-                initial,
-            } => {
-                let r = x.hypot(y).hypot(z).min(rs);
-                let c = PI / rs;
-                let mut sum = 0.0;
-                for n in 1..=terms(a, t, c) {
-                    let lam = c * n as f64;
-                    let sign = if n % 2 == 1 { 1.0 } else { -1.0 };
-                    // sin(λr)/(λr) → 1 at the centre
-                    let sinc = if lam * r < 1e-8 {
-                        1.0
-                    } else {
-                        (lam * r).sin() / (lam * r)
-                    };
-                    sum += 2.0 * sign * sinc * (-a * lam * lam * t).exp();
-                }
-                surface + (initial - surface) * sum
-            }
-            Reference::NeumannFreezing {
-                x0,
-                surface,
-                initial,
-                freezing,
-                ..
-            } => {
-                let (l, af, am) = neumann_root(self).expect("a Neumann reference");
-                let s = (x - x0).max(0.0);
-                if t <= 0.0 {
-                    return if s > 0.0 { initial } else { surface };
-                }
-                if s < 2.0 * l * (af * t).sqrt() {
-                    surface
-                        + (freezing - surface) * libm::erf(s / (2.0 * (af * t).sqrt()))
-                            / libm::erf(l)
-                } else {
-                    let nu = (af / am).sqrt();
-                    initial
-                        + (freezing - initial) * libm::erfc(s / (2.0 * (am * t).sqrt()))
-                            / libm::erfc(l * nu)
-                }
-            }
+            Reference::SphereFixedSurface { .. } => self.sphere(x, y, z, t),
+            Reference::NeumannFreezing { .. } => self.neumann(x, t),
             Reference::AnnulusSteady {
                 inner_radius: ri,
                 outer_radius: ro,
@@ -594,64 +564,9 @@ impl Reference {
                 let r = x.hypot(y);
                 inner + (outer - inner) * (r / ri).ln() / (ro / ri).ln()
             }
-            Reference::BarFixedEnds {
-                x0,
-                length: l,
-                diffusivity: a,
-                left,
-                right,
-                initial,
-            } => {
-                let s = x - x0;
-                let c = PI / l;
-                let mut sum = left + (right - left) * s / l;
-                for n in 1..=terms(a, t, c) {
-                    let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
-                    let b = 2.0 / (n as f64 * PI) * (initial * (1.0 - sign) - left + right * sign);
-                    let lam = c * n as f64;
-                    sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
-                }
-                sum
-            }
-            Reference::BarInsulatedLeft {
-                x0,
-                length: l,
-                diffusivity: a,
-                right,
-                initial_left,
-                initial_right,
-            } => {
-                let s = x - x0;
-                let mut sum = right;
-                let c = PI / (2.0 * l);
-                for n in 1..=terms(a, t, 2.0 * c) {
-                    let lam = c * (2 * n - 1) as f64;
-                    let cn = 2.0 / (l * lam)
-                        * ((initial_left - right) * (lam * l / 2.0).sin()
-                            + (initial_right - right) * ((lam * l).sin() - (lam * l / 2.0).sin()));
-                    sum += cn * (lam * s).cos() * (-a * lam * lam * t).exp();
-                }
-                sum
-            }
-            Reference::BarFixedFlux {
-                x0,
-                length: l,
-                diffusivity: a,
-                left,
-                gradient: g,
-                initial,
-            } => {
-                let s = x - x0;
-                let mut sum = left + g * s;
-                let c = PI / (2.0 * l);
-                for n in 1..=terms(a, t, 2.0 * c) {
-                    let lam = c * (2 * n - 1) as f64;
-                    let alt = if n % 2 == 1 { 1.0 } else { -1.0 };
-                    let b = 2.0 / l * ((initial - left) / lam - g * alt / (lam * lam));
-                    sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
-                }
-                sum
-            }
+            Reference::BarFixedEnds { .. } => self.bar_fixed_ends(x, t),
+            Reference::BarInsulatedLeft { .. } => self.bar_insulated_left(x, t),
+            Reference::BarFixedFlux { .. } => self.bar_fixed_flux(x, t),
             Reference::BarPulseLeft {
                 x0,
                 length: l,
@@ -668,6 +583,170 @@ impl Reference {
                 initial,
             } => edge + (initial - edge) * slab(x - x0, l, a, t) * slab(y - y0, l, a, t),
         }
+    }
+
+    /// A [`Reference::FilmLaserPulse`] at x, t (the cosine series of [`LaserPulse`]), °C.
+    fn laser_film(&self, x: f64, t: f64) -> f64 {
+        let Reference::FilmLaserPulse {
+            x0,
+            length,
+            diffusivity,
+            heat_capacity,
+            fluence,
+            reflectivity,
+            depth,
+            duration,
+            shape,
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let pulse = LaserPulse {
+            length,
+            diffusivity,
+            heat_capacity,
+            fluence,
+            reflectivity,
+            depth,
+            duration,
+            shape,
+        };
+        pulse.eval((x - x0).clamp(0.0, length), t)
+    }
+
+    /// A [`Reference::SphereFixedSurface`] at (x, y, z), t: the radial sine series, °C.
+    fn sphere(&self, x: f64, y: f64, z: f64, t: f64) -> f64 {
+        let Reference::SphereFixedSurface {
+            radius: rs,
+            diffusivity: a,
+            surface,
+            initial,
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let r = x.hypot(y).hypot(z).min(rs);
+        let c = PI / rs;
+        let mut sum = 0.0;
+        for n in 1..=terms(a, t, c) {
+            let lam = c * n as f64;
+            let sign = if n % 2 == 1 { 1.0 } else { -1.0 };
+            // sin(λr)/(λr) → 1 at the centre
+            let sinc = if lam * r < 1e-8 {
+                1.0
+            } else {
+                (lam * r).sin() / (lam * r)
+            };
+            sum += 2.0 * sign * sinc * (-a * lam * lam * t).exp();
+        }
+        surface + (initial - surface) * sum
+    }
+
+    /// A [`Reference::NeumannFreezing`] at x, t: the erf profile behind the front and the
+    /// erfc profile ahead of it, °C.
+    fn neumann(&self, x: f64, t: f64) -> f64 {
+        let Reference::NeumannFreezing {
+            x0,
+            surface,
+            initial,
+            freezing,
+            ..
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let (l, af, am) = neumann_root(self).expect("a Neumann reference");
+        let s = (x - x0).max(0.0);
+        if t <= 0.0 {
+            return if s > 0.0 { initial } else { surface };
+        }
+        if s < 2.0 * l * (af * t).sqrt() {
+            surface + (freezing - surface) * libm::erf(s / (2.0 * (af * t).sqrt())) / libm::erf(l)
+        } else {
+            let nu = (af / am).sqrt();
+            initial
+                + (freezing - initial) * libm::erfc(s / (2.0 * (am * t).sqrt()))
+                    / libm::erfc(l * nu)
+        }
+    }
+
+    /// A [`Reference::BarFixedEnds`] at x, t: the linear steady state plus the sine series
+    /// (Bobaru & Duangpanya 2010, eq. 33), °C.
+    fn bar_fixed_ends(&self, x: f64, t: f64) -> f64 {
+        let Reference::BarFixedEnds {
+            x0,
+            length: l,
+            diffusivity: a,
+            left,
+            right,
+            initial,
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let s = x - x0;
+        let c = PI / l;
+        let mut sum = left + (right - left) * s / l;
+        for n in 1..=terms(a, t, c) {
+            let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+            let b = 2.0 / (n as f64 * PI) * (initial * (1.0 - sign) - left + right * sign);
+            let lam = c * n as f64;
+            sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
+        }
+        sum
+    }
+
+    /// A [`Reference::BarInsulatedLeft`] at x, t: the odd cosine modes from the two-step
+    /// initial field (Bobaru & Duangpanya 2010, eq. 38), °C.
+    fn bar_insulated_left(&self, x: f64, t: f64) -> f64 {
+        let Reference::BarInsulatedLeft {
+            x0,
+            length: l,
+            diffusivity: a,
+            right,
+            initial_left,
+            initial_right,
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let s = x - x0;
+        let mut sum = right;
+        let c = PI / (2.0 * l);
+        for n in 1..=terms(a, t, 2.0 * c) {
+            let lam = c * (2 * n - 1) as f64;
+            let cn = 2.0 / (l * lam)
+                * ((initial_left - right) * (lam * l / 2.0).sin()
+                    + (initial_right - right) * ((lam * l).sin() - (lam * l / 2.0).sin()));
+            sum += cn * (lam * s).cos() * (-a * lam * lam * t).exp();
+        }
+        sum
+    }
+
+    /// A [`Reference::BarFixedFlux`] at x, t: the linear steady state plus the odd sine modes
+    /// (Bobaru & Duangpanya 2010, eq. 43), °C.
+    fn bar_fixed_flux(&self, x: f64, t: f64) -> f64 {
+        let Reference::BarFixedFlux {
+            x0,
+            length: l,
+            diffusivity: a,
+            left,
+            gradient: g,
+            initial,
+        } = *self
+        else {
+            return f64::NAN;
+        };
+        let s = x - x0;
+        let mut sum = left + g * s;
+        let c = PI / (2.0 * l);
+        for n in 1..=terms(a, t, 2.0 * c) {
+            let lam = c * (2 * n - 1) as f64;
+            let alt = if n % 2 == 1 { 1.0 } else { -1.0 };
+            let b = 2.0 / l * ((initial - left) / lam - g * alt / (lam * lam));
+            sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
+        }
+        sum
     }
 }
 
@@ -1029,17 +1108,19 @@ mod tests {
     /// against finite differences in tests/convergence/series.rs).
     #[test]
     fn laser_series_meets_its_data() {
-        let (l, t0, a, depth) = (2e-8, 100e-15, 1.992, 15.3e-9);
-        let film = Reference::FilmLaserPulse {
-            x0: 0.0,
+        let film = Reference::laser_film_example();
+        let Reference::FilmLaserPulse {
             length: l,
-            diffusivity: 1.26e-4,
-            heat_capacity: 2.5e6,
-            fluence: 13.4,
-            reflectivity: 0.93,
+            heat_capacity: rho_c,
+            fluence,
+            reflectivity,
             depth,
             duration: t0,
             shape: a,
+            ..
+        } = film
+        else {
+            unreachable!("the laser example is a laser film")
         };
         assert_eq!(film.eval(0.0, 0.0, 0.0, 0.0), 0.0);
         for t in [1e-13, 2e-13, 7e-13] {
@@ -1059,8 +1140,8 @@ mod tests {
             for k in 1..n {
                 sum += f(k) * if k % 2 == 1 { 4.0 } else { 2.0 };
             }
-            let heat = 2.5e6 * sum * l / (3.0 * n as f64);
-            let s0 = 0.94 * 13.4 * (1.0 - 0.93) / (t0 * depth);
+            let heat = rho_c * sum * l / (3.0 * n as f64);
+            let s0 = 0.94 * fluence * (1.0 - reflectivity) / (t0 * depth);
             let exact =
                 s0 * depth * (1.0 - (-l / depth).exp()) * pulse_integral(0.0, 2.0 * t0, t0 / a, t);
             assert!(
@@ -1099,18 +1180,7 @@ mod tests {
     /// uniform field times the slab factor.
     #[test]
     fn split_series_meets_its_data() {
-        let split = |below: f64, above: f64| Reference::PlatePulseSplit {
-            x0: -5.0,
-            y0: -5.0,
-            length: 10.0,
-            width: 10.0,
-            diffusivity: 1.0,
-            amplitude: 5.0,
-            rate: 2.0,
-            split: 0.0,
-            below,
-            above,
-        };
+        let split = |below: f64, above: f64| Reference::split_plate_example(0.0, below, above);
         let p = split(0.5, 0.0);
         let t: f64 = 3.0;
         let g = 5.0 * t * (-2.0 * t).exp();

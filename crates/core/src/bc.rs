@@ -164,6 +164,71 @@ pub struct BoundaryInput<'a> {
     pub source: Option<Expr>,
 }
 
+impl Relation1d {
+    /// The flux relation of `face` of a 1D cloud: the nodes within a horizon of the face are
+    /// slaved to the nearest node beyond (the anchor); `None` without an anchor.
+    fn build(input: &BoundaryInput, face: usize, value: &Expr) -> Option<Relation1d> {
+        let cloud = input.cloud;
+        let mut slaved = Vec::new();
+        let mut anchor = None;
+        let mut best = f64::INFINITY;
+        for i in 0..cloud.n_body {
+            let d = cloud.set_distance(&cloud.pos[i], face);
+            if d < cloud.horizon[i] * (1.0 - 1e-9) {
+                slaved.push((i, d));
+            } else if d < best {
+                best = d;
+                anchor = Some(i);
+            }
+        }
+        let a = anchor?;
+        Some(Relation1d {
+            slaved: slaved.into_iter().map(|(i, d)| (i, best - d)).collect(),
+            anchor: a,
+            value: value.clone(),
+            conductivity: input.conductivity[a],
+            at: cloud.set_foot(&cloud.pos[a], face).0,
+        })
+    }
+}
+
+impl RelationNodal {
+    /// The flux relations of the first node layer of `face` (2D, 3D; Bobaru & Duangpanya
+    /// 2012 §3.2): each node's stencil of inward body neighbours weighted by micro-conductance
+    /// times the normal offset; nodes without one are left out.
+    fn build_face(input: &BoundaryInput, face: usize, value: &Expr) -> Vec<RelationNodal> {
+        let cloud = input.cloud;
+        let nb = cloud.n_body;
+        let (h, micro) = input
+            .micro
+            .expect("micro-conductances are given for nodal flux relations");
+        let mut out = Vec::new();
+        for i in cloud.set_layer(face, 1.0) {
+            let normal = cloud.set_foot(&cloud.pos[i], face).1;
+            let mut stencil = Vec::new();
+            let mut wsum = 0.0;
+            for bnd in h.row(i) {
+                let j = h.targets[bnd] as usize;
+                let l = (cloud.pos[j] - cloud.pos[i]).dot(&normal);
+                if l > 0.0 && j < nb {
+                    let w = micro[bnd] * l;
+                    stencil.push((j as NodeId, w));
+                    wsum += w;
+                }
+            }
+            if wsum > 0.0 {
+                out.push(RelationNodal {
+                    node: i,
+                    stencil,
+                    wsum,
+                    value: value.clone(),
+                });
+            }
+        }
+        out
+    }
+}
+
 impl Boundary {
     /// Builds the constraint and load structures.
     pub fn build(input: BoundaryInput) -> Self {
@@ -185,54 +250,13 @@ impl Boundary {
                     });
                 }
                 FaceBc::RelationFlux { value } if cloud.dim == 1 => {
-                    let mut slaved = Vec::new();
-                    let mut anchor = None;
-                    let mut best = f64::INFINITY;
-                    for i in 0..nb {
-                        let d = cloud.set_distance(&cloud.pos[i], face);
-                        if d < cloud.horizon[i] * (1.0 - 1e-9) {
-                            slaved.push((i, d));
-                        } else if d < best {
-                            best = d;
-                            anchor = Some(i);
-                        }
-                    }
-                    if let Some(a) = anchor {
-                        b.relation1d.push(Relation1d {
-                            slaved: slaved.into_iter().map(|(i, d)| (i, best - d)).collect(),
-                            anchor: a,
-                            value: value.clone(),
-                            conductivity: input.conductivity[a],
-                            at: cloud.set_foot(&cloud.pos[a], face).0,
-                        });
+                    if let Some(r) = Relation1d::build(&input, face, value) {
+                        b.relation1d.push(r);
                     }
                 }
                 FaceBc::RelationFlux { value } => {
-                    let (h, micro) = input
-                        .micro
-                        .expect("micro-conductances are given for nodal flux relations");
-                    for i in cloud.set_layer(face, 1.0) {
-                        let normal = cloud.set_foot(&cloud.pos[i], face).1;
-                        let mut stencil = Vec::new();
-                        let mut wsum = 0.0;
-                        for bnd in h.row(i) {
-                            let j = h.targets[bnd] as usize;
-                            let l = (cloud.pos[j] - cloud.pos[i]).dot(&normal);
-                            if l > 0.0 && j < nb {
-                                let w = micro[bnd] * l;
-                                stencil.push((j as NodeId, w));
-                                wsum += w;
-                            }
-                        }
-                        if wsum > 0.0 {
-                            b.relation_nodal.push(RelationNodal {
-                                node: i,
-                                stencil,
-                                wsum,
-                                value: value.clone(),
-                            });
-                        }
-                    }
+                    b.relation_nodal
+                        .extend(RelationNodal::build_face(&input, face, value));
                 }
                 FaceBc::Convection { h, ambient } => {
                     let nodes = cloud
@@ -248,19 +272,7 @@ impl Boundary {
                 _ => {}
             }
         }
-        for n in &b.nodal {
-            for &i in &n.nodes {
-                b.driven[i] = true;
-            }
-        }
-        for r in &b.relation1d {
-            for &(i, _) in &r.slaved {
-                b.driven[i] = true;
-            }
-        }
-        for r in &b.relation_nodal {
-            b.driven[r.node] = true;
-        }
+        b.mark_driven();
         b.build_ghosts(cloud, input.conductivity);
         if let Some(s) = &b.source {
             if s.is_time_independent() {
@@ -273,6 +285,23 @@ impl Boundary {
             }
         }
         b
+    }
+
+    /// Marks the body nodes that a nodal condition or a flux relation sets.
+    fn mark_driven(&mut self) {
+        for n in &self.nodal {
+            for &i in &n.nodes {
+                self.driven[i] = true;
+            }
+        }
+        for r in &self.relation1d {
+            for &(i, _) in &r.slaved {
+                self.driven[i] = true;
+            }
+        }
+        for r in &self.relation_nodal {
+            self.driven[r.node] = true;
+        }
     }
 
     /// θ_f = σ θ(image) + Σ coef·g along a chain of reflections (outermost first).

@@ -123,80 +123,84 @@ impl Enthalpy {
     }
 }
 
+/// What a material property must be, with the phrase its error message uses.
+#[derive(Debug, Clone, Copy)]
+enum Requirement {
+    /// A positive normal number (subnormal values make ρc or 1/(Vρc) underflow or overflow).
+    Positive,
+    /// Any finite number.
+    Finite,
+    /// Finite and ≥ 0.
+    NonNegative,
+    /// In [0, 1].
+    Fraction,
+}
+
+impl Requirement {
+    /// Whether `v` meets the requirement.
+    fn holds(self, v: f64) -> bool {
+        match self {
+            Requirement::Positive => v.is_normal() && v > 0.0,
+            Requirement::Finite => v.is_finite(),
+            Requirement::NonNegative => v.is_finite() && v >= 0.0,
+            Requirement::Fraction => (0.0..=1.0).contains(&v),
+        }
+    }
+
+    /// The phrase after "must be" in the error message.
+    fn phrase(self) -> &'static str {
+        match self {
+            Requirement::Positive => "a positive number",
+            Requirement::Finite => "finite",
+            Requirement::NonNegative => "finite and ≥ 0",
+            Requirement::Fraction => "in [0, 1]",
+        }
+    }
+}
+
 impl Material {
-    /// Checks every property: `Err((key, message))` names the offending key, e.g.
-    /// `phase_change.latent_heat`.
-    pub fn check(&self) -> Result<(), (String, String)> {
-        // subnormal values (below 2.2e-308) make ρc or 1/(Vρc) underflow or overflow
-        let positive = |v: f64| v.is_normal() && v > 0.0;
+    /// Every checked property as (key, value, requirement), in the order they are checked.
+    fn requirements(&self) -> Vec<(&'static str, f64, Requirement)> {
+        use Requirement::*;
         let mut checks = vec![
-            (
-                "conductivity",
-                self.conductivity,
-                positive(self.conductivity),
-                "a positive number",
-            ),
-            (
-                "density",
-                self.density,
-                positive(self.density),
-                "a positive number",
-            ),
-            (
-                "specific_heat",
-                self.specific_heat,
-                positive(self.specific_heat),
-                "a positive number",
-            ),
+            ("conductivity", self.conductivity, Positive),
+            ("density", self.density, Positive),
+            ("specific_heat", self.specific_heat, Positive),
         ];
         if let Some(p) = self.phase_change {
             let rho = p.frozen_density.unwrap_or(self.density);
             checks.extend([
-                (
-                    "phase_change.temperature",
-                    p.temperature,
-                    p.temperature.is_finite(),
-                    "finite",
-                ),
-                (
-                    "phase_change.latent_heat",
-                    p.latent_heat,
-                    p.latent_heat.is_finite() && p.latent_heat >= 0.0,
-                    "finite and ≥ 0",
-                ),
-                (
-                    "phase_change.fraction",
-                    p.fraction,
-                    (0.0..=1.0).contains(&p.fraction),
-                    "in [0, 1]",
-                ),
+                ("phase_change.temperature", p.temperature, Finite),
+                ("phase_change.latent_heat", p.latent_heat, NonNegative),
+                ("phase_change.fraction", p.fraction, Fraction),
                 (
                     "phase_change.frozen_conductivity",
                     p.frozen_conductivity,
-                    positive(p.frozen_conductivity),
-                    "a positive number",
+                    Positive,
                 ),
-                (
-                    "phase_change.frozen_density",
-                    rho,
-                    positive(rho),
-                    "a positive number",
-                ),
+                ("phase_change.frozen_density", rho, Positive),
                 (
                     "phase_change.frozen_specific_heat",
                     p.frozen_specific_heat,
-                    positive(p.frozen_specific_heat),
-                    "a positive number",
+                    Positive,
                 ),
             ]);
         }
-        if let Some((key, v, _, what)) = checks.into_iter().find(|c| !c.2) {
+        checks
+    }
+
+    /// Checks every property: `Err((key, message))` names the offending key, e.g.
+    /// `phase_change.latent_heat`.
+    pub fn check(&self) -> Result<(), (String, String)> {
+        let failed = self.requirements().into_iter().find(|c| !c.2.holds(c.1));
+        if let Some((key, v, requirement)) = failed {
             // tiny and huge values in exponent form (a subnormal's digits fill a screen)
             let v = if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
                 format!("{v:e}")
             } else {
                 format!("{v}")
             };
+            let what = requirement.phrase();
             return Err((key.to_string(), format!("must be {what}, got {v}")));
         }
         // each factor may be normal while ρc or k/(ρc) is not

@@ -274,46 +274,176 @@ fn pair_cuts(
     out
 }
 
+/// The bonds of a model after the cracks and the consistency correction: the stage of
+/// [`Model::build`] between the neighbour search and the boundary.
+struct Bonds {
+    /// Directed bond weights ([`directed_weights`]) with the cut factors applied.
+    weights: Vec<f64>,
+    /// The assembled (and possibly corrected) conductance.
+    conductance: Conductance,
+    /// The consistency correction, when one was asked for and applies.
+    correction: Option<Consistency>,
+    /// Which body nodes met the consistency conditions.
+    consistent: Vec<bool>,
+    /// Conductance entries of the bonds cut later by growing cracks.
+    growth: Vec<PairCut>,
+    /// The bond factors of the cracks alone (for damage).
+    crack_cuts: Cuts,
+}
+
+/// Checks the materials of a spec and the conditions that do not combine with phase change;
+/// true when some material changes phase.
+fn check_spec(spec: &ModelSpec) -> Result<bool> {
+    for (m, mat) in spec.materials.iter().enumerate() {
+        mat.check()
+            .map_err(|(key, message)| Error::model(format!("material[{m}].{key}"), message))?;
+    }
+    let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
+    if phase
+        && spec
+            .faces
+            .iter()
+            .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
+    {
+        return Err(Error::model(
+            "boundary",
+            "a flux condition with method = \"relation\" does not apply with phase change; use method = \"mirror\"",
+        ));
+    }
+    Ok(phase)
+}
+
+/// The node cloud of a spec with its fictitious layers on the `layered` faces and its
+/// symmetry applied.
+fn build_cloud(spec: &ModelSpec, layered: &[bool]) -> Result<Cloud> {
+    let band = match spec.kernel.partial_volume {
+        PartialVolume::AllOrNothing => 0.0,
+        PartialVolume::Algorithm1 => 0.5,
+    };
+    let mut cloud = match &spec.geometry {
+        Geometry::Box(g) => {
+            let mask = (0..6).filter(|&f| layered[f]).fold(0u8, |m, f| m | 1 << f);
+            // one horizon plus the partial-volume band of the coarsest spacing
+            let max_spacing = g.regions.iter().map(|r| r.spacing()).fold(0.0, f64::max);
+            let max_horizon = g
+                .regions
+                .iter()
+                .map(|r| r.horizon.horizon(r.spacing()))
+                .fold(0.0, f64::max);
+            g.generate(mask, max_horizon + band * max_spacing)?
+        }
+        Geometry::Mesh(g) => g.generate(layered, band)?,
+    };
+    cloud.apply_symmetry(spec.symmetry)?;
+    Ok(cloud)
+}
+
+impl Bonds {
+    /// Weights, crack and boundary cuts, the conductance and its consistency correction;
+    /// `bond_conductivity` per node, W/(m·K).
+    fn build(
+        spec: &ModelSpec,
+        cloud: &Cloud,
+        horizons: &Horizons,
+        layered: &[bool],
+        bond_conductivity: &[f64],
+    ) -> Bonds {
+        let mut weights = directed_weights(
+            cloud,
+            horizons,
+            &spec.kernel,
+            bond_conductivity,
+            spec.bond_rule,
+        );
+        let cutters = cutters(cloud, &spec.cracks);
+        let cuts = bond_factors(cloud, horizons, &cutters);
+        let mu = &cuts.mu;
+        // damage counts cracks only: bonds the boundary cuts (holes, notches) never existed
+        let crack_cuts = if spec.cracks.is_empty() {
+            Cuts::default()
+        } else {
+            bond_factors(cloud, horizons, &crack_cutters(cloud, &spec.cracks))
+        };
+        if spec.crack_correction {
+            crate::crack::restore_moment(cloud, horizons, &crack_cuts.mu, &mut weights);
+        }
+        for (w, m) in weights.iter_mut().zip(mu) {
+            *w *= m;
+        }
+        let mut conductance = Conductance::assemble(cloud, horizons, &weights);
+        let (correction, consistent) =
+            if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
+                let sel = complete_horizons(cloud, horizons, layered, mu);
+                let (c, met) = correct(
+                    &mut conductance,
+                    cloud,
+                    &sel,
+                    bond_conductivity,
+                    spec.consistency,
+                );
+                (Some(c), met)
+            } else {
+                (None, vec![false; cloud.n_body])
+            };
+        let growth = pair_cuts(cloud, horizons, &conductance, &cuts.later);
+        Bonds {
+            weights,
+            conductance,
+            correction,
+            consistent,
+            growth,
+            crack_cuts,
+        }
+    }
+
+    /// The micro-conductances 2w/V_i of every directed bond (w its weight, V_i the volume
+    /// of its node), when a nodal flux relation needs them (2D and 3D); `None` otherwise.
+    fn micro(&self, spec: &ModelSpec, cloud: &Cloud, horizons: &Horizons) -> Option<Vec<f64>> {
+        let needs_micro = spec
+            .faces
+            .iter()
+            .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
+            && cloud.dim > 1;
+        needs_micro.then(|| {
+            (0..horizons.len())
+                .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
+                .map(|(i, b)| 2.0 * self.weights[b] / cloud.volume[i])
+                .collect()
+        })
+    }
+}
+
+/// The enthalpy curves of a phase-change model with the conductivity and capacity bounds
+/// that set its stable step (maximum conductivity, minimum capacity per node); without phase
+/// change, `conductivity` and `capacity` unchanged.
+fn heat_properties(
+    spec: &ModelSpec,
+    cloud: &Cloud,
+    phase: bool,
+    conductivity: Vec<f64>,
+    capacity: Vec<f64>,
+) -> (Option<Vec<Enthalpy>>, Vec<f64>, Vec<f64>) {
+    let enthalpy: Option<Vec<Enthalpy>> =
+        phase.then(|| spec.materials.iter().map(Material::enthalpy).collect());
+    let (conductivity, capacity) = match &enthalpy {
+        Some(e) => {
+            let at = |i: usize| e[cloud.material[i] as usize];
+            (
+                (0..cloud.len()).map(|i| at(i).max_conductivity()).collect(),
+                (0..cloud.len()).map(|i| at(i).min_capacity()).collect(),
+            )
+        }
+        None => (conductivity, capacity),
+    };
+    (enthalpy, conductivity, capacity)
+}
+
 impl Model {
     /// Builds cloud, bonds, conductance and boundary from a spec.
     pub fn build(spec: &ModelSpec) -> Result<Model> {
-        for (m, mat) in spec.materials.iter().enumerate() {
-            mat.check()
-                .map_err(|(key, message)| Error::model(format!("material[{m}].{key}"), message))?;
-        }
-        let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
-        if phase
-            && spec
-                .faces
-                .iter()
-                .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
-        {
-            return Err(Error::model(
-                "boundary",
-                "a flux condition with method = \"relation\" does not apply with phase change; use method = \"mirror\"",
-            ));
-        }
+        let phase = check_spec(spec)?;
         let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
-        let band = match spec.kernel.partial_volume {
-            PartialVolume::AllOrNothing => 0.0,
-            PartialVolume::Algorithm1 => 0.5,
-        };
-        let cloud = match &spec.geometry {
-            Geometry::Box(g) => {
-                let mask = (0..6).filter(|&f| layered[f]).fold(0u8, |m, f| m | 1 << f);
-                // one horizon plus the partial-volume band of the coarsest spacing
-                let max_spacing = g.regions.iter().map(|r| r.spacing()).fold(0.0, f64::max);
-                let max_horizon = g
-                    .regions
-                    .iter()
-                    .map(|r| r.horizon.horizon(r.spacing()))
-                    .fold(0.0, f64::max);
-                g.generate(mask, max_horizon + band * max_spacing)?
-            }
-            Geometry::Mesh(g) => g.generate(&layered, band)?,
-        };
-        let mut cloud = cloud;
-        cloud.apply_symmetry(spec.symmetry)?;
+        let cloud = build_cloud(spec, &layered)?;
         let mat = |i: usize| spec.materials[cloud.material[i] as usize];
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
@@ -324,57 +454,8 @@ impl Model {
         } else {
             conductivity.clone()
         };
-        let mut weights = directed_weights(
-            &cloud,
-            &horizons,
-            &spec.kernel,
-            &bond_conductivity,
-            spec.bond_rule,
-        );
-        let cutters = cutters(&cloud, &spec.cracks);
-        let cuts = bond_factors(&cloud, &horizons, &cutters);
-        let mu = &cuts.mu;
-        // damage counts cracks only: bonds the boundary cuts (holes, notches) never existed
-        let crack_cuts = if spec.cracks.is_empty() {
-            Cuts::default()
-        } else {
-            bond_factors(&cloud, &horizons, &crack_cutters(&cloud, &spec.cracks))
-        };
-        if spec.crack_correction {
-            crate::crack::restore_moment(&cloud, &horizons, &crack_cuts.mu, &mut weights);
-        }
-        for (w, m) in weights.iter_mut().zip(mu) {
-            *w *= m;
-        }
-        let mut conductance = Conductance::assemble(&cloud, &horizons, &weights);
-        let (correction, consistent) =
-            if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
-                let sel = complete_horizons(&cloud, &horizons, &layered, mu);
-                let (c, met) = correct(
-                    &mut conductance,
-                    &cloud,
-                    &sel,
-                    &bond_conductivity,
-                    spec.consistency,
-                );
-                (Some(c), met)
-            } else {
-                (None, vec![false; cloud.n_body])
-            };
-        let needs_micro = spec
-            .faces
-            .iter()
-            .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
-            && cloud.dim > 1;
-        let growth = pair_cuts(&cloud, &horizons, &conductance, &cuts.later);
-        let micro: Vec<f64> = if needs_micro {
-            (0..horizons.len())
-                .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
-                .map(|(i, b)| 2.0 * weights[b] / cloud.volume[i])
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let bonds = Bonds::build(spec, &cloud, &horizons, &layered, &bond_conductivity);
+        let micro = bonds.micro(spec, &cloud, &horizons);
         // with phase change the loads are enthalpy rates (W/m³): unit capacity
         let unit = vec![1.0; if phase { cloud.len() } else { 0 }];
         let boundary = Boundary::build(BoundaryInput {
@@ -382,30 +463,24 @@ impl Model {
             faces: spec.faces.clone(),
             conductivity: &conductivity,
             capacity: if phase { &unit } else { &capacity },
-            micro: if needs_micro {
-                Some((&horizons, &micro))
-            } else {
-                None
-            },
+            micro: micro.as_deref().map(|m| (&horizons, m)),
             source: spec.source.clone(),
         });
-        let enthalpy: Option<Vec<Enthalpy>> =
-            phase.then(|| spec.materials.iter().map(Material::enthalpy).collect());
-        let (conductivity, capacity) = match &enthalpy {
-            Some(e) => {
-                let at = |i: usize| e[cloud.material[i] as usize];
-                (
-                    (0..cloud.len()).map(|i| at(i).max_conductivity()).collect(),
-                    (0..cloud.len()).map(|i| at(i).min_capacity()).collect(),
-                )
-            }
-            None => (conductivity, capacity),
-        };
+        let (enthalpy, conductivity, capacity) =
+            heat_properties(spec, &cloud, phase, conductivity, capacity);
         let inv_heat_capacity = (0..cloud.n_body)
             .map(|i| 1.0 / (cloud.volume[i] * capacity[i]))
             .collect();
         let mut theta0 = spec.initial.at(&cloud.pos, &cloud.region, "node")?;
         boundary.apply(&cloud, &mut theta0, 0.0);
+        let Bonds {
+            conductance,
+            correction,
+            consistent,
+            growth,
+            crack_cuts,
+            ..
+        } = bonds;
         Ok(Model {
             cloud,
             horizons,

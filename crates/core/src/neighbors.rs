@@ -155,6 +155,65 @@ fn reaches(cloud: &Cloud, kernel: &Kernel) -> Vec<f64> {
         .collect()
 }
 
+/// Pass 1 of [`Horizons::build_with`]: the sorted bonds (`keep(i, j)` is `Some`) of each
+/// block of [`SEARCH_CHUNK`] rows, in parallel, with each row's length written into `lens`.
+fn search_blocks<F>(
+    finder: &Finder,
+    pts: &[[f64; 3]],
+    reach: &[f64],
+    keep: &F,
+    lens: &mut [usize],
+) -> Vec<Vec<NodeId>>
+where
+    F: Fn(usize, usize) -> Option<f64> + Sync,
+{
+    lens.par_chunks_mut(SEARCH_CHUNK)
+        .enumerate()
+        .map(|(c, lens)| {
+            let first = c * SEARCH_CHUNK;
+            let mut list = Vec::new();
+            let mut found = Vec::new();
+            for (r, len) in lens.iter_mut().enumerate() {
+                let i = first + r;
+                found.clear();
+                finder.within(pts, i, reach[i] * reach[i] * (1.0 + 1e-12), &mut found);
+                found.retain(|&j| keep(i, j as usize).is_some());
+                found.sort_unstable();
+                *len = found.len();
+                list.extend_from_slice(&found);
+            }
+            list.shrink_to_fit();
+            list
+        })
+        .collect()
+}
+
+/// The targets and β of each of `n_blocks` blocks of [`SEARCH_CHUNK`] rows, as disjoint
+/// mutable slices of the final arrays (CSR row starts `offsets`), for pass 2.
+fn block_parts<'a>(
+    offsets: &[usize],
+    n_blocks: usize,
+    targets: &'a mut [NodeId],
+    beta: &'a mut [f64],
+) -> Vec<(&'a mut [NodeId], &'a mut [f64])> {
+    let total = targets.len();
+    let starts: Vec<usize> = (0..n_blocks)
+        .map(|c| offsets[c * SEARCH_CHUNK])
+        .chain(std::iter::once(total))
+        .collect();
+    let mut t_rest = targets;
+    let mut b_rest = beta;
+    let mut parts = Vec::with_capacity(n_blocks);
+    for w in starts.windows(2) {
+        let len = w[1] - w[0];
+        let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(len);
+        let (b, br) = std::mem::take(&mut b_rest).split_at_mut(len);
+        parts.push((t, b));
+        (t_rest, b_rest) = (tr, br);
+    }
+    parts
+}
+
 impl Horizons {
     /// Finds, for every node, the neighbours inside its horizon (fixed-radius search, radius
     /// δ_i plus the partial-volume band). Bonds between two fictitious nodes are dropped.
@@ -201,26 +260,7 @@ impl Horizons {
         };
         // pass 1: sorted neighbour lists of each block of rows, and the row lengths
         let mut lens = vec![0usize; n];
-        let blocks: Vec<Vec<NodeId>> = lens
-            .par_chunks_mut(SEARCH_CHUNK)
-            .enumerate()
-            .map(|(c, lens)| {
-                let first = c * SEARCH_CHUNK;
-                let mut list = Vec::new();
-                let mut found = Vec::new();
-                for (r, len) in lens.iter_mut().enumerate() {
-                    let i = first + r;
-                    found.clear();
-                    finder.within(&pts, i, reach[i] * reach[i] * (1.0 + 1e-12), &mut found);
-                    found.retain(|&j| keep(i, j as usize).is_some());
-                    found.sort_unstable();
-                    *len = found.len();
-                    list.extend_from_slice(&found);
-                }
-                list.shrink_to_fit();
-                list
-            })
-            .collect();
+        let blocks = search_blocks(&finder, &pts, &reach, &keep, &mut lens);
         drop(finder);
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0usize);
@@ -235,20 +275,7 @@ impl Horizons {
             beta: vec![0.0; total],
         };
         // pass 2: copy each block into place with β
-        let starts: Vec<usize> = (0..blocks.len())
-            .map(|c| h.offsets[c * SEARCH_CHUNK])
-            .chain(std::iter::once(total))
-            .collect();
-        let mut t_rest = &mut h.targets[..];
-        let mut b_rest = &mut h.beta[..];
-        let mut parts = Vec::with_capacity(blocks.len());
-        for w in starts.windows(2) {
-            let len = w[1] - w[0];
-            let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(len);
-            let (b, br) = std::mem::take(&mut b_rest).split_at_mut(len);
-            parts.push((t, b));
-            (t_rest, b_rest) = (tr, br);
-        }
+        let parts = block_parts(&h.offsets, blocks.len(), &mut h.targets, &mut h.beta);
         let offsets = &h.offsets;
         blocks
             .into_par_iter()

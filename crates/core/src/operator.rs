@@ -138,53 +138,73 @@ fn find(row: &[NodeId], i: NodeId, guess: usize) -> Option<usize> {
     }
 }
 
+/// The bonds j → i into a body node i that has no bond i → j, as (i, j, w_ji) sorted by
+/// (i, j); none when every node has the same horizon and spacing (β_ij = β_ji: the relation
+/// is symmetric). In parallel.
+fn lone_bonds(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Vec<(NodeId, NodeId, f64)> {
+    let n = horizons.len();
+    let nb = cloud.n_body;
+    let targets = &horizons.targets;
+    let row = |i: usize| &targets[horizons.row(i)];
+    let uniform = |v: &[f64]| v.iter().all(|x| x.to_bits() == v[0].to_bits());
+    let symmetric = n > 0 && uniform(&cloud.horizon) && uniform(&cloud.spacing);
+    let mut lone: Vec<(NodeId, NodeId, f64)> = (0..if symmetric { 0 } else { n })
+        .into_par_iter()
+        .with_min_len(1024)
+        .flat_map_iter(|j| {
+            let out = row(j);
+            let start = horizons.offsets[j];
+            out.iter().enumerate().filter_map(move |(p, &i)| {
+                let iu = i as usize;
+                if iu >= nb {
+                    return None;
+                }
+                let back = row(iu);
+                let guess = back.len().wrapping_sub(p + 1);
+                match find(back, j as NodeId, guess.min(back.len())) {
+                    Some(_) => None,
+                    None => Some((i, j as NodeId, weights[start + p])),
+                }
+            })
+        })
+        .collect();
+    lone.par_sort_unstable_by_key(|e| (e.0, e.1));
+    lone
+}
+
+/// The CSR layout of K: where each body row's lone bonds start in `lone` (`nb + 1` entries),
+/// and where each row starts in K (its outgoing bonds plus its lone bonds).
+fn row_offsets(
+    horizons: &Horizons,
+    nb: usize,
+    lone: &[(NodeId, NodeId, f64)],
+) -> (Vec<usize>, Vec<usize>) {
+    let mut lone_off = vec![0usize; nb + 1];
+    for e in lone {
+        lone_off[e.0 as usize + 1] += 1;
+    }
+    for i in 0..nb {
+        lone_off[i + 1] += lone_off[i];
+    }
+    let mut offsets = Vec::with_capacity(nb + 1);
+    offsets.push(0usize);
+    for i in 0..nb {
+        let len = horizons.row(i).len() + lone_off[i + 1] - lone_off[i];
+        offsets.push(offsets[i] + len);
+    }
+    (lone_off, offsets)
+}
+
 impl Conductance {
     /// Assembles K from the directed bonds and their half-conductances (in parallel, no
     /// transpose): K_ij = w_ij + w_ji with w_ji found in row j, plus the bonds j → i whose
     /// reverse does not exist (at horizon changes), collected separately.
     pub fn assemble(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Self {
-        let n = horizons.len();
         let nb = cloud.n_body;
         let targets = &horizons.targets;
         let row = |i: usize| &targets[horizons.row(i)];
-        // bonds j -> i into a body node i that has no bond i -> j: (i, j, w_ji); none when
-        // every node has the same horizon and spacing (β_ij = β_ji: the relation is symmetric)
-        let uniform = |v: &[f64]| v.iter().all(|x| x.to_bits() == v[0].to_bits());
-        let symmetric = n > 0 && uniform(&cloud.horizon) && uniform(&cloud.spacing);
-        let mut lone: Vec<(NodeId, NodeId, f64)> = (0..if symmetric { 0 } else { n })
-            .into_par_iter()
-            .with_min_len(1024)
-            .flat_map_iter(|j| {
-                let out = row(j);
-                let start = horizons.offsets[j];
-                out.iter().enumerate().filter_map(move |(p, &i)| {
-                    let iu = i as usize;
-                    if iu >= nb {
-                        return None;
-                    }
-                    let back = row(iu);
-                    let guess = back.len().wrapping_sub(p + 1);
-                    match find(back, j as NodeId, guess.min(back.len())) {
-                        Some(_) => None,
-                        None => Some((i, j as NodeId, weights[start + p])),
-                    }
-                })
-            })
-            .collect();
-        lone.par_sort_unstable_by_key(|e| (e.0, e.1));
-        let mut lone_off = vec![0usize; nb + 1];
-        for e in &lone {
-            lone_off[e.0 as usize + 1] += 1;
-        }
-        for i in 0..nb {
-            lone_off[i + 1] += lone_off[i];
-        }
-        let mut offsets = Vec::with_capacity(nb + 1);
-        offsets.push(0usize);
-        for i in 0..nb {
-            let len = horizons.row(i).len() + lone_off[i + 1] - lone_off[i];
-            offsets.push(offsets[i] + len);
-        }
+        let lone = lone_bonds(cloud, horizons, weights);
+        let (lone_off, offsets) = row_offsets(horizons, nb, &lone);
         let nnz = offsets[nb];
         let mut cols = vec![0 as NodeId; nnz];
         let mut vals = vec![0.0; nnz];

@@ -39,21 +39,7 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
         .iter()
         .map(|c| measure_and_centroid(c.kind, &mesh.corners(c)[..c.kind.n_nodes()]).0)
         .collect();
-    let grads = mesh
-        .cells
-        .iter()
-        .map(|c| {
-            let s = shape(c.kind, centre(c.kind));
-            let (mut g, _) = physical(c.kind, &s, &mesh.corners(c), d);
-            let k = materials[c.material as usize].conductivity;
-            for row in g.iter_mut() {
-                for v in row.iter_mut() {
-                    *v *= k;
-                }
-            }
-            g
-        })
-        .collect();
+    let grads = centre_gradients(mesh, materials);
     let (offsets, cells) = mesh.node_cells();
     let nn = mesh.nodes.len();
     let mut around = Vec::with_capacity(cells.len());
@@ -72,6 +58,60 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
             material[i] = mesh.cells[e as usize].material;
         }
     }
+    let pos = separated_positions(mesh, &offsets, &cells, &spacing);
+    let (lo, hi) = bounding_box(&mesh.nodes);
+    let cloud = Cloud {
+        dim: d,
+        tau: mesh.tau,
+        pos,
+        volume: sys.measure.clone(),
+        spacing,
+        horizon: vec![0.0; nn],
+        material,
+        region,
+        n_body: nn,
+        min: lo,
+        max: hi,
+        symmetry: mesh.symmetry,
+        ..Default::default()
+    };
+    (
+        cloud,
+        Recovery {
+            grads,
+            offsets,
+            around,
+        },
+    )
+}
+
+/// k ∂N_a/∂x at the centre of every cell of `mesh`, W/(m·K) per m.
+fn centre_gradients(mesh: &FemMesh, materials: &[Material]) -> Vec<[[f64; 3]; MAX_NODES]> {
+    mesh.cells
+        .iter()
+        .map(|c| {
+            let s = shape(c.kind, centre(c.kind));
+            let (mut g, _) = physical(c.kind, &s, &mesh.corners(c), mesh.dim);
+            let k = materials[c.material as usize].conductivity;
+            for row in g.iter_mut() {
+                for v in row.iter_mut() {
+                    *v *= k;
+                }
+            }
+            g
+        })
+        .collect()
+}
+
+/// The output positions of the mesh nodes: the copies of a node split along a crack moved
+/// 1e-9 × their spacing towards the centre of their cells (`offsets`/`cells` from
+/// [`FemMesh::node_cells`]), the other nodes where they are, m.
+fn separated_positions(
+    mesh: &FemMesh,
+    offsets: &[usize],
+    cells: &[(u32, u8)],
+    spacing: &[f64],
+) -> Vec<Point> {
     let mut pos = mesh.nodes.clone();
     let mut at: std::collections::HashMap<[u64; 3], Vec<usize>> = Default::default();
     for (i, p) in mesh.nodes.iter().enumerate() {
@@ -98,37 +138,20 @@ pub fn output_cloud(mesh: &FemMesh, sys: &System, materials: &[Material]) -> (Cl
             }
         }
     }
+    pos
+}
+
+/// The lower and upper corners of the box around `nodes`, m.
+fn bounding_box(nodes: &[Point]) -> (Point, Point) {
     let mut lo = Point::new(f64::MAX, f64::MAX, f64::MAX);
     let mut hi = Point::new(f64::MIN, f64::MIN, f64::MIN);
-    for p in &mesh.nodes {
+    for p in nodes {
         for a in 0..3 {
             lo[a] = lo[a].min(p[a]);
             hi[a] = hi[a].max(p[a]);
         }
     }
-    let cloud = Cloud {
-        dim: d,
-        tau: mesh.tau,
-        pos,
-        volume: sys.measure.clone(),
-        spacing,
-        horizon: vec![0.0; nn],
-        material,
-        region,
-        n_body: nn,
-        min: lo,
-        max: hi,
-        symmetry: mesh.symmetry,
-        ..Default::default()
-    };
-    (
-        cloud,
-        Recovery {
-            grads,
-            offsets,
-            around,
-        },
-    )
+    (lo, hi)
 }
 
 impl Recovery {

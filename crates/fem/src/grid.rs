@@ -111,16 +111,17 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
             axis_lines(g.min[a], g.max[a], &c, h, eps)
         })
         .collect();
-    let count = [lines[0].len(), lines[1].len(), lines[2].len()];
-    let cells_per = |a: usize| if a < dim { count[a] - 1 } else { 1 };
-    if count.iter().product::<usize>() > u32::MAX as usize / 2 {
+    let grid = Grid {
+        dim,
+        count: [lines[0].len(), lines[1].len(), lines[2].len()],
+    };
+    if grid.count.iter().product::<usize>() > u32::MAX as usize / 2 {
         return Err(Error::model(
             "h",
             "fem: too many grid nodes; use a larger --h",
         ));
     }
-    let id = |i: usize, j: usize, k: usize| (i + count[0] * (j + count[1] * k)) as u32;
-    let mut nodes = Vec::with_capacity(count.iter().product());
+    let mut nodes = Vec::with_capacity(grid.count.iter().product());
     for &z in &lines[2] {
         for &y in &lines[1] {
             for &x in &lines[0] {
@@ -128,37 +129,80 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
             }
         }
     }
+    let mut m = FemMesh {
+        dim,
+        tau: g.tau,
+        nodes,
+        cells: grid_cells(g, &grid, &lines)?,
+        sets: vec![Vec::new(); 6],
+        symmetry: peritherm_core::symmetry::Symmetry::Planar,
+    };
+    face_sets(&mut m, g, eps);
+    Ok(m)
+}
+
+/// The node counts of a tensor-product grid along x, y, z (1 along unused axes).
+struct Grid {
+    dim: usize,
+    count: [usize; 3],
+}
+
+impl Grid {
+    /// Cells along axis `a` (1 along unused axes).
+    fn cells_per(&self, a: usize) -> usize {
+        if a < self.dim {
+            self.count[a] - 1
+        } else {
+            1
+        }
+    }
+
+    /// Index of the node (i, j, k), x fastest.
+    fn id(&self, i: usize, j: usize, k: usize) -> u32 {
+        (i + self.count[0] * (j + self.count[1] * k)) as u32
+    }
+
+    /// The nodes of the cell (i, j, k) in the element's order (line, quad or hex).
+    fn cell_nodes(&self, i: usize, j: usize, k: usize) -> [u32; MAX_NODES] {
+        let id = |i, j, k| self.id(i, j, k);
+        let mut n = [0u32; MAX_NODES];
+        match self.dim {
+            1 => n[..2].copy_from_slice(&[id(i, 0, 0), id(i + 1, 0, 0)]),
+            2 => n[..4].copy_from_slice(&[
+                id(i, j, 0),
+                id(i + 1, j, 0),
+                id(i + 1, j + 1, 0),
+                id(i, j + 1, 0),
+            ]),
+            _ => {
+                n = [
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ]
+            }
+        }
+        n
+    }
+}
+
+/// The cells of the grid with grid lines `lines`, each in the region that holds its centre.
+fn grid_cells(g: &BoxGeometry, grid: &Grid, lines: &[Vec<f64>]) -> Result<Vec<Cell>> {
+    let (dim, count) = (grid.dim, grid.count);
     let kind = match dim {
         1 => ElementKind::Line,
         2 => ElementKind::Quad,
         _ => ElementKind::Hex,
     };
-    let mut cells = Vec::with_capacity(cells_per(0) * cells_per(1) * cells_per(2));
-    for k in 0..cells_per(2) {
-        for j in 0..cells_per(1) {
-            for i in 0..cells_per(0) {
-                let mut n = [0u32; MAX_NODES];
-                match dim {
-                    1 => n[..2].copy_from_slice(&[id(i, 0, 0), id(i + 1, 0, 0)]),
-                    2 => n[..4].copy_from_slice(&[
-                        id(i, j, 0),
-                        id(i + 1, j, 0),
-                        id(i + 1, j + 1, 0),
-                        id(i, j + 1, 0),
-                    ]),
-                    _ => {
-                        n = [
-                            id(i, j, k),
-                            id(i + 1, j, k),
-                            id(i + 1, j + 1, k),
-                            id(i, j + 1, k),
-                            id(i, j, k + 1),
-                            id(i + 1, j, k + 1),
-                            id(i + 1, j + 1, k + 1),
-                            id(i, j + 1, k + 1),
-                        ]
-                    }
-                }
+    let mut cells = Vec::with_capacity(grid.cells_per(0) * grid.cells_per(1) * grid.cells_per(2));
+    for k in 0..grid.cells_per(2) {
+        for j in 0..grid.cells_per(1) {
+            for i in 0..grid.cells_per(0) {
                 let centre = [
                     0.5 * (lines[0][i] + lines[0][(i + 1).min(count[0] - 1)]),
                     0.5 * (lines[1][j] + lines[1][(j + 1).min(count[1] - 1)]),
@@ -171,22 +215,19 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
                     .ok_or_else(|| Error::model("region", "fem: a grid cell lies in no region"))?;
                 cells.push(Cell {
                     kind,
-                    nodes: n,
+                    nodes: grid.cell_nodes(i, j, k),
                     region: r as u16,
                     material: g.regions[r].material,
                 });
             }
         }
     }
-    let mut m = FemMesh {
-        dim,
-        tau: g.tau,
-        nodes,
-        cells,
-        sets: vec![Vec::new(); 6],
-        symmetry: peritherm_core::symmetry::Symmetry::Planar,
-    };
-    // boundary facets: facets of one cell only, classified by the face plane they lie on
+    Ok(cells)
+}
+
+/// Fills the six face sets of `m`: the boundary facets (facets of one cell only), each in
+/// the set of the box face plane it lies on.
+fn face_sets(m: &mut FemMesh, g: &BoxGeometry, eps: f64) {
     let map = m.facet_map();
     let mut boundary: Vec<_> = map
         .values()
@@ -196,7 +237,7 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
     boundary.sort_unstable();
     for f in boundary {
         let pts: Vec<Point> = m.facet_nodes(f).map(|n| m.nodes[n as usize]).collect();
-        for face in 0..2 * dim {
+        for face in 0..2 * m.dim {
             let (a, plane) = (
                 face / 2,
                 if face % 2 == 0 {
@@ -211,7 +252,6 @@ pub fn box_mesh(g: &BoxGeometry, h: f64, cracks: &[Crack]) -> Result<FemMesh> {
             }
         }
     }
-    Ok(m)
 }
 
 #[cfg(test)]

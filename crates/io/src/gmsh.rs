@@ -214,8 +214,28 @@ fn kind_of(t: ElementType) -> Option<ElementKind> {
     })
 }
 
+/// The mshio file type this reader parses.
+type Msh = MshFile<u64, i32, f64>;
+
 /// Assembles the mesh from mshio's sections and the physical names.
-fn build(msh: &MshFile<u64, i32, f64>, mut names: Names) -> Msg<Mesh> {
+fn build(msh: &Msh, mut names: Names) -> Msg<Mesh> {
+    let entity_groups = entity_groups(msh, &mut names);
+    let groups = GroupTable::new(names)?;
+    let nodes = NodeTable::read(msh)?;
+    let elements = read_elements(msh, &entity_groups, &groups, &nodes)?;
+    if elements.is_empty() {
+        return Err(no_mesh("elements in its physical groups"));
+    }
+    Ok(Mesh {
+        nodes: nodes.nodes,
+        elements,
+        groups: groups.groups,
+    })
+}
+
+/// The physical tags of every (dimension, entity tag) of `$Entities`; every physical tag
+/// without a name in `names` gets its number as name.
+fn entity_groups<'a>(msh: &'a Msh, names: &mut Names) -> HashMap<(i32, i32), &'a [i32]> {
     let mut entity_groups: HashMap<(i32, i32), &[i32]> = HashMap::new();
     if let Some(e) = &msh.data.entities {
         let all = (e.points.iter().map(|p| (0, p.tag, &p.physical_tags)))
@@ -229,41 +249,88 @@ fn build(msh: &MshFile<u64, i32, f64>, mut names: Names) -> Msg<Mesh> {
             entity_groups.insert((dim, tag), physical);
         }
     }
-    if names.is_empty() {
-        return Err(NO_GROUPS.into());
-    }
-    let index: HashMap<(i32, i32), u16> = names.keys().copied().zip(0..=u16::MAX).collect();
-    if index.len() < names.len() {
-        return Err("has more than 65536 physical groups".into());
-    }
-    let to_group = |((dim, tag), name): ((i32, i32), String)| Group {
-        dim: dim as usize,
-        tag,
-        name,
-    };
-    let groups: Vec<Group> = names.into_iter().map(to_group).collect();
+    entity_groups
+}
 
-    let blocks = msh.data.nodes.iter().flat_map(|n| &n.node_blocks);
-    let (mut nodes, mut sparse) = (Vec::new(), HashMap::new());
-    for block in blocks.clone() {
-        let offset = nodes.len();
-        let tags = block.node_tags.iter().flatten();
-        sparse.extend(tags.map(|(&tag, &i)| (tag, offset + i)));
-        nodes.extend(block.nodes.iter().map(|n| Point::new(n.x, n.y, n.z)));
-    }
-    if nodes.is_empty() {
-        return Err(no_mesh("nodes"));
-    }
-    let dense = blocks.clone().all(|b| b.node_tags.is_none());
-    let min_tag = msh.data.nodes.as_ref().map_or(0, |n| n.min_node_tag);
-    let node_index = |tag: u64| {
-        let i = match dense {
-            true => usize::try_from(tag.checked_sub(min_tag)?).ok()?,
-            false => *sparse.get(&tag)?,
+/// The physical groups in (dimension, tag) order and the index of each.
+struct GroupTable {
+    /// Index in `groups` of each (dimension, physical tag).
+    index: HashMap<(i32, i32), u16>,
+    groups: Vec<Group>,
+}
+
+impl GroupTable {
+    /// The table of the named groups; an error when there is none or more than 65536.
+    fn new(names: Names) -> Msg<GroupTable> {
+        if names.is_empty() {
+            return Err(NO_GROUPS.into());
+        }
+        let index: HashMap<(i32, i32), u16> = names.keys().copied().zip(0..=u16::MAX).collect();
+        if index.len() < names.len() {
+            return Err("has more than 65536 physical groups".into());
+        }
+        let to_group = |((dim, tag), name): ((i32, i32), String)| Group {
+            dim: dim as usize,
+            tag,
+            name,
         };
-        u32::try_from(i).ok().filter(|_| i < nodes.len())
-    };
+        let groups: Vec<Group> = names.into_iter().map(to_group).collect();
+        Ok(GroupTable { index, groups })
+    }
+}
 
+/// The nodes of `$Nodes` and how a node tag finds its index.
+struct NodeTable {
+    nodes: Vec<Point>,
+    /// Index of each tag when the blocks list their tags.
+    sparse: HashMap<u64, usize>,
+    /// True when no block lists tags: node tags run from `min_tag` in order.
+    dense: bool,
+    min_tag: u64,
+}
+
+impl NodeTable {
+    /// Reads every node block; an error when there is no node.
+    fn read(msh: &Msh) -> Msg<NodeTable> {
+        let blocks = msh.data.nodes.iter().flat_map(|n| &n.node_blocks);
+        let (mut nodes, mut sparse) = (Vec::new(), HashMap::new());
+        for block in blocks.clone() {
+            let offset = nodes.len();
+            let tags = block.node_tags.iter().flatten();
+            sparse.extend(tags.map(|(&tag, &i)| (tag, offset + i)));
+            nodes.extend(block.nodes.iter().map(|n| Point::new(n.x, n.y, n.z)));
+        }
+        if nodes.is_empty() {
+            return Err(no_mesh("nodes"));
+        }
+        let dense = blocks.clone().all(|b| b.node_tags.is_none());
+        let min_tag = msh.data.nodes.as_ref().map_or(0, |n| n.min_node_tag);
+        Ok(NodeTable {
+            nodes,
+            sparse,
+            dense,
+            min_tag,
+        })
+    }
+
+    /// The index of the node tagged `tag`, `None` when `$Nodes` lacks it.
+    fn index(&self, tag: u64) -> Option<u32> {
+        let i = match self.dense {
+            true => usize::try_from(tag.checked_sub(self.min_tag)?).ok()?,
+            false => *self.sparse.get(&tag)?,
+        };
+        u32::try_from(i).ok().filter(|_| i < self.nodes.len())
+    }
+}
+
+/// The supported elements of the entities that belong to a physical group, each with its
+/// groups; an error for an unsupported type, a type of the wrong dimension or a missing node.
+fn read_elements(
+    msh: &Msh,
+    entity_groups: &HashMap<(i32, i32), &[i32]>,
+    groups: &GroupTable,
+    nodes: &NodeTable,
+) -> Msg<Vec<Element>> {
     let mut elements = Vec::new();
     for block in msh.data.elements.iter().flat_map(|e| &e.element_blocks) {
         let (dim, t) = (block.entity_dim, block.element_type);
@@ -272,9 +339,9 @@ fn build(msh: &MshFile<u64, i32, f64>, mut names: Names) -> Msg<Mesh> {
         };
         let member: Vec<u16> = physical
             .iter()
-            .filter_map(|p| index.get(&(dim, *p)).copied())
+            .filter_map(|p| groups.index.get(&(dim, *p)).copied())
             .collect();
-        let Some(group) = member.first().map(|&g| &groups[usize::from(g)].name) else {
+        let Some(group) = member.first().map(|&g| &groups.groups[usize::from(g)].name) else {
             continue;
         };
         let unsupported = || {
@@ -294,7 +361,7 @@ fn build(msh: &MshFile<u64, i32, f64>, mut names: Names) -> Msg<Mesh> {
             let nodes = e
                 .nodes
                 .iter()
-                .map(|&n| node_index(n).ok_or_else(|| lacks(n)));
+                .map(|&n| nodes.index(n).ok_or_else(|| lacks(n)));
             let nodes = nodes.collect::<Msg<_>>()?;
             elements.push(Element {
                 kind,
@@ -303,14 +370,7 @@ fn build(msh: &MshFile<u64, i32, f64>, mut names: Names) -> Msg<Mesh> {
             });
         }
     }
-    if elements.is_empty() {
-        return Err(no_mesh("elements in its physical groups"));
-    }
-    Ok(Mesh {
-        nodes,
-        elements,
-        groups,
-    })
+    Ok(elements)
 }
 
 #[cfg(test)]

@@ -429,6 +429,14 @@ fn complete() -> String {
 }
 
 impl RunSummary {
+    /// The index of the output at time `t`, s: the first output time within 1e-9 of `t`
+    /// (relative), as two runs of one case write them.
+    pub fn output_index(&self, t: f64) -> Option<usize> {
+        self.output_times
+            .iter()
+            .position(|x| (x - t).abs() <= 1e-9 * t.abs())
+    }
+
     /// Reads `dir/run.json`.
     pub fn read(dir: &Path) -> Result<RunSummary> {
         let path = dir.join("run.json");

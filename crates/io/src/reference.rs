@@ -35,31 +35,23 @@ pub struct ReferenceTable {
 /// Two times are the same output when they differ by at most this fraction (of max(|t|, 1e-12 s)).
 const TIME_TOLERANCE: f64 = 1e-9;
 
-impl ReferenceTable {
-    /// Reads a reference CSV for a case of dimension `dim`.
-    pub fn read(path: &Path, dim: usize) -> Result<ReferenceTable> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
-            file: path.to_path_buf(),
-            key: "-".into(),
-            message: format!("cannot read the reference: {e}"),
-        })?;
-        ReferenceTable::parse(&text, path, dim)
-    }
+/// An error's key and message, before the file is added.
+type KeyMessage = (String, String);
 
-    /// Parses reference CSV text; `path` is used in messages.
-    pub fn parse(text: &str, path: &Path, dim: usize) -> Result<ReferenceTable> {
-        let err = |key: String, message: String| Error::Case {
-            file: path.to_path_buf(),
-            key,
-            message,
-        };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let Some((_, header)) = lines.next() else {
-            return Err(err("header".into(), "the file is empty".into()));
-        };
+/// Where the columns a reference needs are in its rows.
+struct Columns {
+    /// Dimension of the points.
+    dim: usize,
+    /// The names wanted: time, the coordinates, temperature.
+    wanted: Vec<&'static str>,
+    /// The column of each wanted name.
+    column: Vec<usize>,
+}
+
+impl Columns {
+    /// The columns of `header` for a case of dimension `dim`; an error for a coordinate
+    /// beyond `dim` or a missing column.
+    fn find(header: &str, dim: usize) -> std::result::Result<Columns, KeyMessage> {
         let names: Vec<String> = header
             .split(',')
             .map(|c| c.trim().to_ascii_lowercase())
@@ -67,7 +59,7 @@ impl ReferenceTable {
         let axes = ["x", "y", "z"];
         for extra in &axes[dim..] {
             if names.iter().any(|n| n == extra) {
-                return Err(err(
+                return Err((
                     "header".into(),
                     format!("has a `{extra}` column but the case is {dim}D; export {dim}D points (columns time,{},temperature)", axes[..dim].join(",")),
                 ));
@@ -81,7 +73,7 @@ impl ReferenceTable {
             match names.iter().position(|n| n == w) {
                 Some(c) => column.push(c),
                 None => {
-                    return Err(err(
+                    return Err((
                         "header".into(),
                         format!(
                             "missing column `{w}` (a {dim}D reference needs {}; found {})",
@@ -92,50 +84,94 @@ impl ReferenceTable {
                 }
             }
         }
-        let mut rows: Vec<(f64, Point, f64)> = Vec::new();
-        for (k, line) in lines {
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            let mut v = [0.0; 5];
-            for (slot, (&c, w)) in v.iter_mut().zip(column.iter().zip(&wanted)) {
-                let cell = cells.get(c).copied().unwrap_or("");
-                *slot = match cell.parse::<f64>() {
-                    Ok(x) if x.is_finite() => x,
-                    _ => {
-                        return Err(err(
-                            format!("line {}", k + 1),
-                            format!("column `{w}`: `{cell}` is not a finite number"),
-                        ))
-                    }
-                };
-            }
-            let mut p = Point::origin();
-            for a in 0..dim {
-                p[a] = v[1 + a];
-            }
-            rows.push((v[0], p, v[1 + dim]));
-        }
-        if rows.is_empty() {
-            return Err(err("-".into(), "no data rows after the header".into()));
-        }
-        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut snapshots: Vec<Snapshot> = Vec::new();
-        for (t, p, theta) in rows {
-            match snapshots.last_mut() {
-                Some(s) if same_time(s.time, t) => {
-                    s.pos.push(p);
-                    s.theta.push(theta);
+        Ok(Columns {
+            dim,
+            wanted,
+            column,
+        })
+    }
+
+    /// (time s, point m, temperature °C) of the data line `line` (index `k` in the file).
+    fn row(&self, k: usize, line: &str) -> std::result::Result<(f64, Point, f64), KeyMessage> {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let mut v = [0.0; 5];
+        for (slot, (&c, w)) in v.iter_mut().zip(self.column.iter().zip(&self.wanted)) {
+            let cell = cells.get(c).copied().unwrap_or("");
+            *slot = match cell.parse::<f64>() {
+                Ok(x) if x.is_finite() => x,
+                _ => {
+                    return Err((
+                        format!("line {}", k + 1),
+                        format!("column `{w}`: `{cell}` is not a finite number"),
+                    ))
                 }
-                _ => snapshots.push(Snapshot {
-                    time: t,
-                    pos: vec![p],
-                    theta: vec![theta],
-                }),
+            };
+        }
+        let mut p = Point::origin();
+        for a in 0..self.dim {
+            p[a] = v[1 + a];
+        }
+        Ok((v[0], p, v[1 + self.dim]))
+    }
+}
+
+/// The rows grouped into snapshots of the same time, in increasing time.
+fn snapshots(mut rows: Vec<(f64, Point, f64)>) -> Vec<Snapshot> {
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut snapshots: Vec<Snapshot> = Vec::new();
+    for (t, p, theta) in rows {
+        match snapshots.last_mut() {
+            Some(s) if same_time(s.time, t) => {
+                s.pos.push(p);
+                s.theta.push(theta);
             }
+            _ => snapshots.push(Snapshot {
+                time: t,
+                pos: vec![p],
+                theta: vec![theta],
+            }),
+        }
+    }
+    snapshots
+}
+
+impl ReferenceTable {
+    /// Reads a reference CSV for a case of dimension `dim`.
+    pub fn read(path: &Path, dim: usize) -> Result<ReferenceTable> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
+            file: path.to_path_buf(),
+            key: "-".into(),
+            message: format!("cannot read the reference: {e}"),
+        })?;
+        ReferenceTable::parse(&text, path, dim)
+    }
+
+    /// Parses reference CSV text; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path, dim: usize) -> Result<ReferenceTable> {
+        let err = |(key, message): KeyMessage| Error::Case {
+            file: path.to_path_buf(),
+            key,
+            message,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+        let Some((_, header)) = lines.next() else {
+            return Err(err(("header".into(), "the file is empty".into())));
+        };
+        let columns = Columns::find(header, dim).map_err(err)?;
+        let rows = lines
+            .map(|(k, line)| columns.row(k, line))
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(err)?;
+        if rows.is_empty() {
+            return Err(err(("-".into(), "no data rows after the header".into())));
         }
         Ok(ReferenceTable {
             path: path.to_path_buf(),
             dim,
-            snapshots,
+            snapshots: snapshots(rows),
         })
     }
 

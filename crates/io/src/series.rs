@@ -14,99 +14,107 @@ pub trait SeriesCheck {
 
 impl SeriesCheck for Reference {
     fn check(&self) -> Option<String> {
-        // every parameter finite (non-finite numbers serialise as null), every length,
-        // diffusivity and material constant a normal positive number
-        let value = serde_json::to_value(self).unwrap_or_default();
-        for (name, v) in value.as_object().into_iter().flatten() {
-            let numbers: Vec<Option<f64>> = match v {
-                serde_json::Value::Array(a) if a.iter().any(|x| x.is_string()) => continue,
-                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
-                serde_json::Value::String(_) => continue,
-                x => vec![x.as_f64()],
-            };
-            if numbers.iter().any(|x| x.is_none_or(|x| !x.is_finite())) {
-                return Some(format!("{name} must be finite, got {v}"));
-            }
-            let must_be_positive = [
-                "length",
-                "diffusivity",
-                "radius",
-                "density",
-                "latent_heat",
-                "width",
-                "heat_capacity",
-                "depth",
-                "duration",
-                "shape",
-            ]
-            .iter()
-            .any(|k| name.contains(k))
-                || name.ends_with("conductivity")
-                || name.ends_with("specific_heat")
-                || name == "size";
-            if must_be_positive
-                && numbers
-                    .iter()
-                    .flatten()
-                    .any(|x| !(x.is_normal() && *x > 0.0))
-            {
-                return Some(format!("{name} must be > 0, got {v}"));
-            }
+        check_numbers(self).or_else(|| check_relations(self))
+    }
+}
+
+/// The serialised keys of the parameters that must be normal positive numbers: lengths,
+/// diffusivities and material constants.
+fn must_be_positive(name: &str) -> bool {
+    [
+        "length",
+        "diffusivity",
+        "radius",
+        "density",
+        "latent_heat",
+        "width",
+        "heat_capacity",
+        "depth",
+        "duration",
+        "shape",
+    ]
+    .iter()
+    .any(|k| name.contains(k))
+        || name.ends_with("conductivity")
+        || name.ends_with("specific_heat")
+        || name == "size"
+}
+
+/// Every parameter finite (non-finite numbers serialise as null), every length,
+/// diffusivity and material constant a normal positive number.
+fn check_numbers(r: &Reference) -> Option<String> {
+    let value = serde_json::to_value(r).unwrap_or_default();
+    for (name, v) in value.as_object().into_iter().flatten() {
+        let numbers: Vec<Option<f64>> = match v {
+            serde_json::Value::Array(a) if a.iter().any(|x| x.is_string()) => continue,
+            serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+            serde_json::Value::String(_) => continue,
+            x => vec![x.as_f64()],
+        };
+        if numbers.iter().any(|x| x.is_none_or(|x| !x.is_finite())) {
+            return Some(format!("{name} must be finite, got {v}"));
         }
-        if let Reference::AnnulusSteady {
+        if must_be_positive(name)
+            && numbers
+                .iter()
+                .flatten()
+                .any(|x| !(x.is_normal() && *x > 0.0))
+        {
+            return Some(format!("{name} must be > 0, got {v}"));
+        }
+    }
+    None
+}
+
+/// The relations between parameters that a series needs (radii in order, one box entry per
+/// axis, a reflectivity below 1, the split inside the plate).
+fn check_relations(r: &Reference) -> Option<String> {
+    match r {
+        Reference::AnnulusSteady {
             inner_radius,
             outer_radius,
             ..
-        } = self
-        {
-            if outer_radius <= inner_radius {
+        } if outer_radius <= inner_radius => Some(format!(
+            "outer_radius {outer_radius} must exceed inner_radius {inner_radius}"
+        )),
+        Reference::BoxFixedFaces {
+            min,
+            size,
+            ends,
+            diffusivity,
+            ..
+        } => {
+            let d = min.len();
+            if !(1..=3).contains(&d) || size.len() != d || ends.len() != d {
                 return Some(format!(
-                    "outer_radius {outer_radius} must exceed inner_radius {inner_radius}"
+                    "min, size and ends need one entry per axis (1 to 3), got {}, {} and {}",
+                    d,
+                    size.len(),
+                    ends.len()
                 ));
             }
-        }
-        match self {
-            Reference::BoxFixedFaces {
-                min,
-                size,
-                ends,
-                diffusivity,
-                ..
-            } => {
-                let d = min.len();
-                if !(1..=3).contains(&d) || size.len() != d || ends.len() != d {
-                    return Some(format!(
-                        "min, size and ends need one entry per axis (1 to 3), got {}, {} and {}",
-                        d,
-                        size.len(),
-                        ends.len()
-                    ));
-                }
-                if size.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
-                    return Some(format!("every size must be > 0, got {size:?}"));
-                }
-                positive("diffusivity", *diffusivity)
+            if size.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+                return Some(format!("every size must be > 0, got {size:?}"));
             }
-            Reference::DiscFixedEdge {
-                radius,
-                diffusivity,
-                ..
-            } => positive("radius", *radius).or_else(|| positive("diffusivity", *diffusivity)),
-            Reference::FilmLaserPulse { reflectivity, .. }
-                if !(0.0..1.0).contains(reflectivity) =>
-            {
-                Some(format!(
-                    "reflectivity must be in [0, 1), got {reflectivity}"
-                ))
-            }
-            Reference::PlatePulseSplit {
-                y0, width, split, ..
-            } if !(*y0..=y0 + width).contains(split) => Some(format!(
-                "split must lie in [y0, y0 + width] = [{y0}, {}], got {split}",
-                y0 + width
-            )),
-            _ => None,
+            positive("diffusivity", *diffusivity)
         }
+        Reference::DiscFixedEdge {
+            radius,
+            diffusivity,
+            ..
+        } => positive("radius", *radius).or_else(|| positive("diffusivity", *diffusivity)),
+        Reference::FilmLaserPulse { reflectivity, .. } if !(0.0..1.0).contains(reflectivity) => {
+            Some(format!(
+                "reflectivity must be in [0, 1), got {reflectivity}"
+            ))
+        }
+        Reference::PlatePulseSplit {
+            y0, width, split, ..
+        } if !(*y0..=y0 + width).contains(split) => Some(format!(
+            "split must lie in [y0, y0 + width] = [{y0}, {}], got {split}",
+            y0 + width
+        )),
+        _ => None,
     }
 }
 
@@ -173,40 +181,18 @@ mod tests {
         assert!(annulus.check().unwrap().contains("outer_radius"));
     }
 
-    /// The laser series' data are accepted (from `analytic`'s laser test, whose series this
-    /// is).
+    /// The laser series' data are accepted (the example that `analytic`'s laser test
+    /// checks).
     #[test]
     fn laser_series_data_are_accepted() {
-        let (l, t0, a, depth) = (2e-8, 100e-15, 1.992, 15.3e-9);
-        let film = Reference::FilmLaserPulse {
-            x0: 0.0,
-            length: l,
-            diffusivity: 1.26e-4,
-            heat_capacity: 2.5e6,
-            fluence: 13.4,
-            reflectivity: 0.93,
-            depth,
-            duration: t0,
-            shape: a,
-        };
-        assert_eq!(film.check(), None);
+        assert_eq!(Reference::laser_film_example().check(), None);
     }
 
-    /// A split outside the plate's width is named (from `analytic`'s split-plate test).
+    /// A split outside the plate's width is named (the example of `analytic`'s split-plate
+    /// test, its split moved).
     #[test]
     fn split_outside_the_plate_is_named() {
-        let bad = Reference::PlatePulseSplit {
-            x0: -5.0,
-            y0: -5.0,
-            length: 10.0,
-            width: 10.0,
-            diffusivity: 1.0,
-            amplitude: 5.0,
-            rate: 2.0,
-            split: 6.0,
-            below: 0.5,
-            above: 0.0,
-        };
+        let bad = Reference::split_plate_example(6.0, 0.5, 0.0);
         assert!(bad.check().unwrap().contains("split"));
     }
 }

@@ -123,39 +123,43 @@ impl MeshGeometry {
                 "has no line, surface or volume elements",
             ));
         }
-        let s = self.scale;
         let cells: Vec<&Element> = mesh
             .elements
             .iter()
             .filter(|e| e.kind.dim() == dim)
             .collect();
-        let extent = mesh
-            .nodes
-            .iter()
-            .map(|p| p.coords.amax())
-            .fold(0.0, f64::max);
-        for e in &cells {
-            for &n in &e.nodes {
-                let p = mesh.nodes[n as usize];
-                if (dim < 3 && p.z.abs() > 1e-9 * extent) || (dim < 2 && p.y.abs() > 1e-9 * extent)
-                {
-                    return Err(Error::model(
-                        "mesh",
-                        format!(
-                            "a {dim}D mesh must lie in the {} (node at {}, {}, {})",
-                            if dim == 2 { "z = 0 plane" } else { "x axis" },
-                            p.x,
-                            p.y,
-                            p.z
-                        ),
-                    ));
-                }
-            }
-        }
+        check_flat(mesh, &cells, dim)?;
+        let raw = self.body_nodes(&cells, dim)?;
         // body nodes at centroids, in Morton order
+        let perm = morton_order(&raw.iter().map(|r| r.1).collect::<Vec<_>>());
+        let mut new_of = vec![0u32; cells.len()];
+        for (new, &old) in perm.iter().enumerate() {
+            new_of[old] = new as u32;
+        }
+        let mut c = self.body_cloud(&raw, &perm, dim);
+        let index = PointIndex::new(&c.pos);
+        if let Some(ratio) = self.horizon_ratio {
+            grade_horizons(&mut c, &index, ratio);
+        }
+        let body: Vec<&Element> = perm.iter().map(|&old| cells[old]).collect();
+        let locate = Locator {
+            mesh,
+            scale: self.scale,
+            cells: &body,
+            index: &index,
+        };
+        let sides = self.sides(&cells, &new_of, &locate)?;
+        mirror_layers(&mut c, &sides, &locate, layered, band);
+        c.sides = Sides::Mesh(Box::new(sides));
+        Ok(c)
+    }
+
+    /// (measure in m^dim, centroid in m, region) of every cell, in the cells' order.
+    fn body_nodes(&self, cells: &[&Element], dim: usize) -> Result<Vec<(f64, Point, usize)>> {
+        let s = self.scale;
         let mut raw = Vec::with_capacity(cells.len());
-        for e in &cells {
-            let (m, c) = measure_and_centroid(e.kind, &mesh.corners(e));
+        for e in cells {
+            let (m, c) = measure_and_centroid(e.kind, &self.mesh.corners(e));
             if m.is_nan() || m <= 0.0 {
                 return Err(Error::model(
                     "mesh",
@@ -171,17 +175,18 @@ impl MeshGeometry {
                 self.region_of(e)?,
             ));
         }
-        let perm = morton_order(&raw.iter().map(|r| r.1).collect::<Vec<_>>());
-        let mut new_of = vec![0u32; cells.len()];
-        for (new, &old) in perm.iter().enumerate() {
-            new_of[old] = new as u32;
-        }
+        Ok(raw)
+    }
+
+    /// The body nodes of the cells `raw` (from [`MeshGeometry::body_nodes`]) in the order
+    /// `perm`, with their bounding box.
+    fn body_cloud(&self, raw: &[(f64, Point, usize)], perm: &[usize], dim: usize) -> Cloud {
         let mut c = Cloud {
             dim,
             tau: self.tau,
             ..Default::default()
         };
-        for &old in &perm {
+        for &old in perm {
             let (m, p, r) = raw[old];
             let reg = &self.regions[r];
             let dx = m.powf(1.0 / dim as f64);
@@ -203,98 +208,28 @@ impl MeshGeometry {
                 c.max[a] = c.max[a].max(p[a]);
             }
         }
-        let index = PointIndex::new(&c.pos);
-        if let Some(ratio) = self.horizon_ratio {
-            grade_horizons(&mut c, &index, ratio);
-        }
-        let body: Vec<&Element> = perm.iter().map(|&old| cells[old]).collect();
-        let locate = Locator {
-            mesh,
-            scale: s,
-            cells: &body,
-            index: &index,
-        };
-        let sides = self.sides(&cells, &new_of, &locate)?;
-        mirror_layers(&mut c, &sides, &locate, layered, band);
-        c.sides = Sides::Mesh(Box::new(sides));
-        Ok(c)
+        c
     }
 
     /// Boundary facets (by topology) and the facets of every set, in metres.
     fn sides(&self, cells: &[&Element], new_of: &[u32], locate: &Locator) -> Result<MeshSides> {
         let mesh = &*self.mesh;
-        let dim = self.dim();
-        let s = self.scale;
-        let mut faces: HashMap<FaceKey, (u32, Vec<u32>, u8)> = HashMap::new();
-        for (k, e) in cells.iter().enumerate() {
-            for f in e.kind.facets() {
-                let nodes: Vec<u32> = f.iter().map(|&i| e.nodes[i]).collect();
-                faces
-                    .entry(key_of(&nodes))
-                    .and_modify(|v| v.2 += 1)
-                    .or_insert((new_of[k], nodes, 1));
-            }
-        }
+        let faces = facet_counts(cells, new_of);
         let mut cell_centre = vec![Point::origin(); cells.len()];
         for (k, e) in cells.iter().enumerate() {
             cell_centre[new_of[k] as usize] = measure_and_centroid(e.kind, &mesh.corners(e)).1;
         }
-        let make = |nodes: &[u32], cell: u32, set: Option<u16>| -> Facet {
-            let q: Vec<Point> = nodes.iter().map(|&n| mesh.nodes[n as usize]).collect();
-            let inside = cell_centre[cell as usize];
-            let mut n = match q.len() {
-                1 => Vector::x(),
-                2 => {
-                    let t = q[1] - q[0];
-                    Vector::new(t.y, -t.x, 0.0)
-                }
-                3 => (q[1] - q[0]).cross(&(q[2] - q[0])),
-                _ => (q[2] - q[0]).cross(&(q[3] - q[1])),
-            }
-            .normalize();
-            if (inside - q[0]).dot(&n) > 0.0 {
-                n = -n;
-            }
-            let (m, _) = measure_and_centroid(facet_kind(q.len()), &q);
-            let tau_area = match dim {
-                1 => self.tau,
-                2 => m * s * self.tau,
-                _ => m * s * s,
-            };
-            Facet {
-                corners: q.iter().map(|p| Point::from(p.coords * s)).collect(),
-                normal: n,
-                area: tau_area,
-                cell,
-                set,
-            }
+        let maker = FacetMaker {
+            geometry: self,
+            dim: self.dim(),
+            cell_centre: &cell_centre,
         };
-        let groups = self.set_groups();
-        let mut owner: HashMap<FaceKey, u16> = HashMap::new();
-        let mut sets = Vec::with_capacity(groups.len());
-        for (si, &g) in groups.iter().enumerate() {
-            let mut list = Vec::new();
-            for e in mesh
-                .elements
-                .iter()
-                .filter(|e| e.groups.contains(&(g as u16)))
-            {
-                let key = key_of(&e.nodes);
-                let Some((cell, _, _)) = faces.get(&key) else {
-                    return Err(Error::model(
-                        format!("mesh group {}", mesh.groups[g].name),
-                        "has an element that is not a side of any body element: re-mesh with the curve (surface) embedded in the body",
-                    ));
-                };
-                owner.entry(key).or_insert(si as u16);
-                list.push(make(&e.nodes, *cell, Some(si as u16)));
-            }
-            sets.push(FacetSet::new(list));
-        }
+        let (mut sets, owner) = self.group_sets(&faces, &maker)?;
+        let s = self.scale;
         let mut boundary: Vec<Facet> = faces
             .iter()
             .filter(|(_, v)| v.2 == 1)
-            .map(|(k, (cell, nodes, _))| make(nodes, *cell, owner.get(k).copied()))
+            .map(|(k, (cell, nodes, _))| maker.make(nodes, *cell, owner.get(k).copied()))
             // a side facing another element is a non-conforming interface, not boundary
             .filter(|f| {
                 let inner = Point::from(cell_centre[f.cell as usize].coords * s);
@@ -327,6 +262,132 @@ impl MeshGeometry {
             boundary: FacetSet::new(boundary),
         })
     }
+
+    /// The facet set of every boundary group (in [`MeshGeometry::set_groups`] order) and the
+    /// first set that owns each facet.
+    fn group_sets(
+        &self,
+        faces: &FacetCounts,
+        maker: &FacetMaker,
+    ) -> Result<(Vec<FacetSet>, HashMap<FaceKey, u16>)> {
+        let mesh = &*self.mesh;
+        let groups = self.set_groups();
+        let mut owner: HashMap<FaceKey, u16> = HashMap::new();
+        let mut sets = Vec::with_capacity(groups.len());
+        for (si, &g) in groups.iter().enumerate() {
+            let mut list = Vec::new();
+            for e in mesh
+                .elements
+                .iter()
+                .filter(|e| e.groups.contains(&(g as u16)))
+            {
+                let key = key_of(&e.nodes);
+                let Some((cell, _, _)) = faces.get(&key) else {
+                    return Err(Error::model(
+                        format!("mesh group {}", mesh.groups[g].name),
+                        "has an element that is not a side of any body element: re-mesh with the curve (surface) embedded in the body",
+                    ));
+                };
+                owner.entry(key).or_insert(si as u16);
+                list.push(maker.make(&e.nodes, *cell, Some(si as u16)));
+            }
+            sets.push(FacetSet::new(list));
+        }
+        Ok((sets, owner))
+    }
+}
+
+/// Makes the facets of a mesh geometry (the body's dimension found once: [`Mesh::dim`]
+/// scans the elements).
+struct FacetMaker<'a> {
+    geometry: &'a MeshGeometry,
+    dim: usize,
+    /// The centroid of every body cell by its body node index, file units.
+    cell_centre: &'a [Point],
+}
+
+impl FacetMaker<'_> {
+    /// A facet of `nodes` (file units) next to body cell `cell`, in metres, with its outward
+    /// normal (away from the cell's centre) and its area times τ.
+    fn make(&self, nodes: &[u32], cell: u32, set: Option<u16>) -> Facet {
+        let g = self.geometry;
+        let s = g.scale;
+        let q: Vec<Point> = nodes.iter().map(|&n| g.mesh.nodes[n as usize]).collect();
+        let inside = self.cell_centre[cell as usize];
+        let mut n = match q.len() {
+            1 => Vector::x(),
+            2 => {
+                let t = q[1] - q[0];
+                Vector::new(t.y, -t.x, 0.0)
+            }
+            3 => (q[1] - q[0]).cross(&(q[2] - q[0])),
+            _ => (q[2] - q[0]).cross(&(q[3] - q[1])),
+        }
+        .normalize();
+        if (inside - q[0]).dot(&n) > 0.0 {
+            n = -n;
+        }
+        let (m, _) = measure_and_centroid(facet_kind(q.len()), &q);
+        let tau_area = match self.dim {
+            1 => g.tau,
+            2 => m * s * g.tau,
+            _ => m * s * s,
+        };
+        Facet {
+            corners: q.iter().map(|p| Point::from(p.coords * s)).collect(),
+            normal: n,
+            area: tau_area,
+            cell,
+            set,
+        }
+    }
+}
+
+/// Every facet of the cells by its sorted nodes: (the new index of the first cell that has
+/// it, its nodes as that cell lists them, how many cells have it).
+type FacetCounts = HashMap<FaceKey, (u32, Vec<u32>, u8)>;
+
+/// The [`FacetCounts`] of `cells`; `new_of` maps a cell's index to its body node.
+fn facet_counts(cells: &[&Element], new_of: &[u32]) -> FacetCounts {
+    let mut faces: FacetCounts = HashMap::new();
+    for (k, e) in cells.iter().enumerate() {
+        for f in e.kind.facets() {
+            let nodes: Vec<u32> = f.iter().map(|&i| e.nodes[i]).collect();
+            faces
+                .entry(key_of(&nodes))
+                .and_modify(|v| v.2 += 1)
+                .or_insert((new_of[k], nodes, 1));
+        }
+    }
+    faces
+}
+
+/// Checks that a 2D mesh lies in the z = 0 plane and a 1D mesh on the x axis (to 1e-9 of
+/// the largest coordinate).
+fn check_flat(mesh: &Mesh, cells: &[&Element], dim: usize) -> Result<()> {
+    let extent = mesh
+        .nodes
+        .iter()
+        .map(|p| p.coords.amax())
+        .fold(0.0, f64::max);
+    for e in cells {
+        for &n in &e.nodes {
+            let p = mesh.nodes[n as usize];
+            if (dim < 3 && p.z.abs() > 1e-9 * extent) || (dim < 2 && p.y.abs() > 1e-9 * extent) {
+                return Err(Error::model(
+                    "mesh",
+                    format!(
+                        "a {dim}D mesh must lie in the {} (node at {}, {}, {})",
+                        if dim == 2 { "z = 0 plane" } else { "x axis" },
+                        p.x,
+                        p.y,
+                        p.z
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Finds whether a point lies in the body, from the cells next to it.

@@ -463,68 +463,15 @@ impl BoxGeometry {
             boundary_placement: self.boundary_placement,
             ..Default::default()
         };
-        let scale = (0..self.dim)
-            .map(|a| self.max[a] - self.min[a])
-            .fold(0.0, f64::max);
-        let eps = GEOMETRIC_TOLERANCE * scale;
-        let on_face = |reg: &BoxRegion, face: Face| {
-            let a = face / 2;
-            if face.is_multiple_of(2) {
-                (reg.min[a] - self.min[a]).abs() < eps
-            } else {
-                (reg.max[a] - self.max[a]).abs() < eps
-            }
-        };
         let mut fict: Vec<(Point, f64, f64, f64, u16, u16, u8)> = Vec::new();
         for (r, reg) in self.regions.iter().enumerate() {
             let h = reg.h(0);
             let delta = reg.horizon.horizon(h);
-            let ext = (layer / h - 1e-9).ceil().max(0.0) as i64;
-            let bp = self.boundary_placement;
-            // index range per axis, extended where the face carries a fictitious layer
-            let mut lo = [0i64; 3];
-            let mut hi = [0i64; 3]; // exclusive
-            for a in 0..3 {
-                if a >= self.dim {
-                    hi[a] = 1;
-                    continue;
-                }
-                let n = reg.cells[a] as i64;
-                hi[a] = if bp { n + 1 } else { n };
-                if fictitious & (1 << (2 * a)) != 0 && on_face(reg, 2 * a) {
-                    lo[a] = -ext;
-                }
-                if fictitious & (1 << (2 * a + 1)) != 0 && on_face(reg, 2 * a + 1) {
-                    hi[a] += ext;
-                }
-            }
+            let (lo, hi) = self.index_range(reg, fictitious, layer);
             for k in lo[2]..hi[2] {
                 for j in lo[1]..hi[1] {
                     for i in lo[0]..hi[0] {
-                        let idx = [i, j, k];
-                        let mut p = [0.0; 3];
-                        let mut v = self.tau;
-                        let mut out = 0u8;
-                        for a in 0..self.dim {
-                            let n = reg.cells[a] as i64;
-                            let off = if bp { 0.0 } else { 0.5 };
-                            p[a] = reg.min[a] + (idx[a] as f64 + off) * h;
-                            let mut frac = 1.0;
-                            if bp && (idx[a] == 0 || idx[a] == n) {
-                                frac = 0.5;
-                            }
-                            if idx[a] < 0 {
-                                out |= 1 << (2 * a);
-                                frac = 1.0;
-                            }
-                            let last = if bp { n } else { n - 1 };
-                            if idx[a] > last {
-                                out |= 1 << (2 * a + 1);
-                                frac = 1.0;
-                            }
-                            v *= h * frac;
-                        }
-                        let pt = Point::new(p[0], p[1], p[2]);
+                        let (pt, v, out) = self.lattice_node(reg, [i, j, k], h);
                         if out == 0 {
                             c.push(pt, v, h, delta, reg.material, r as u16);
                         } else {
@@ -540,6 +487,73 @@ impl BoxGeometry {
             c.fictitious.push(Fictitious::Lattice { outside: out });
         }
         Ok(c)
+    }
+
+    /// The lattice index range [lo, hi) of a region per axis, extended by the layer
+    /// (`layer` m, whole spacings) beyond the domain faces in the `fictitious` bit mask.
+    fn index_range(&self, reg: &BoxRegion, fictitious: u8, layer: f64) -> ([i64; 3], [i64; 3]) {
+        let scale = (0..self.dim)
+            .map(|a| self.max[a] - self.min[a])
+            .fold(0.0, f64::max);
+        let eps = GEOMETRIC_TOLERANCE * scale;
+        // whether the region reaches the domain's face
+        let on_face = |face: Face| {
+            let a = face / 2;
+            if face.is_multiple_of(2) {
+                (reg.min[a] - self.min[a]).abs() < eps
+            } else {
+                (reg.max[a] - self.max[a]).abs() < eps
+            }
+        };
+        let h = reg.h(0);
+        let ext = (layer / h - 1e-9).ceil().max(0.0) as i64;
+        let mut lo = [0i64; 3];
+        let mut hi = [0i64; 3]; // exclusive
+        for a in 0..3 {
+            if a >= self.dim {
+                hi[a] = 1;
+                continue;
+            }
+            let n = reg.cells[a] as i64;
+            hi[a] = if self.boundary_placement { n + 1 } else { n };
+            if fictitious & (1 << (2 * a)) != 0 && on_face(2 * a) {
+                lo[a] = -ext;
+            }
+            if fictitious & (1 << (2 * a + 1)) != 0 && on_face(2 * a + 1) {
+                hi[a] += ext;
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The node of lattice index `idx` of a region of spacing `h` m: its position, its volume
+    /// (halved on the faces with boundary placement), m^dim·τ, and the bit mask of the domain
+    /// faces it lies beyond (0 for a body node).
+    fn lattice_node(&self, reg: &BoxRegion, idx: [i64; 3], h: f64) -> (Point, f64, u8) {
+        let bp = self.boundary_placement;
+        let mut p = [0.0; 3];
+        let mut v = self.tau;
+        let mut out = 0u8;
+        for a in 0..self.dim {
+            let n = reg.cells[a] as i64;
+            let off = if bp { 0.0 } else { 0.5 };
+            p[a] = reg.min[a] + (idx[a] as f64 + off) * h;
+            let mut frac = 1.0;
+            if bp && (idx[a] == 0 || idx[a] == n) {
+                frac = 0.5;
+            }
+            if idx[a] < 0 {
+                out |= 1 << (2 * a);
+                frac = 1.0;
+            }
+            let last = if bp { n } else { n - 1 };
+            if idx[a] > last {
+                out |= 1 << (2 * a + 1);
+                frac = 1.0;
+            }
+            v *= h * frac;
+        }
+        (Point::new(p[0], p[1], p[2]), v, out)
     }
 }
 

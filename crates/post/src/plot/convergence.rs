@@ -2,7 +2,9 @@
 
 use super::line::check_series;
 use super::FONT;
-use super::{extent, palette, plot_error, render, sci, DrawError, Figure, Labels, Legend, Series};
+use super::{
+    extent, palette, plot_error, render, sci, Chart, DrawError, Figure, Labels, Legend, Series,
+};
 use peritherm_core::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -172,7 +174,6 @@ impl Figure for Convergence<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let lg = |p: (f64, f64)| (p.0.log10(), p.1.log10());
         let (x0, y0) = lg((self.x.0, self.y.0));
         let (x1, y1) = lg((self.x.1, self.y.1));
         let mut chart = ChartBuilder::on(root)
@@ -190,38 +191,35 @@ impl Figure for Convergence<'_> {
             .y_desc(&self.labels.y)
             .axis_desc_style((FONT, 20))
             .draw()?;
-        // log ticks, grid lines and labels by hand (plotters' log axes skip the values
-        // below the first power of ten)
-        let label = TextStyle::from((FONT, 18).into_font()).color(&BLACK);
-        let grid = |bold: bool| BLACK.mix(if bold { 0.15 } else { 0.06 }).stroke_width(1);
-        for (v, bold) in log_ticks(x0, x1) {
-            let l = v.log10();
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![(l, y0), (l, y1)],
-                grid(bold),
-            )))?;
-            let (px, py) = chart.backend_coord(&(l, y0));
-            let len = if bold { 6 } else { 3 };
-            root.draw(&PathElement::new(vec![(px, py), (px, py + len)], BLACK))?;
-            if bold {
-                let style = label.pos(Pos::new(HPos::Center, VPos::Top));
-                root.draw(&Text::new(log_tick(v), (px, py + 9), style))?;
-            }
+        draw_log_grid(&mut chart, root, (x0, x1), (y0, y1))?;
+        self.draw_series(&mut chart)?;
+        if let Some(pos) = self.legend.position() {
+            chart
+                .configure_series_labels()
+                .position(pos)
+                .label_font((FONT, 18))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.mix(0.4))
+                .draw()?;
         }
-        for (v, bold) in log_ticks(y0, y1) {
-            let l = v.log10();
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![(x0, l), (x1, l)],
-                grid(bold),
-            )))?;
-            let (px, py) = chart.backend_coord(&(x0, l));
-            let len = if bold { 6 } else { 3 };
-            root.draw(&PathElement::new(vec![(px - len, py), (px, py)], BLACK))?;
-            if bold {
-                let style = label.pos(Pos::new(HPos::Right, VPos::Center));
-                root.draw(&Text::new(log_tick(v), (px - 9, py), style))?;
-            }
-        }
+        Ok(())
+    }
+}
+
+/// (log10 x, log10 y): the chart's coordinates of a data point.
+fn lg(p: (f64, f64)) -> (f64, f64) {
+    (p.0.log10(), p.1.log10())
+}
+
+impl Convergence<'_> {
+    /// Each series as dots with its fitted power law dashed, labelled with its rate.
+    fn draw_series<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut Chart<'a, DB>,
+    ) -> std::result::Result<(), DrawError>
+    where
+        DB::ErrorType: 'static,
+    {
         for (s, law) in self.series.iter().zip(self.laws) {
             let c = palette(s.colour);
             let (a, b) = extent(s.points.iter().map(|p| p.0));
@@ -243,17 +241,52 @@ impl Figure for Convergence<'_> {
                     + Circle::new((12, 0), 5, dot)
             });
         }
-        if let Some(pos) = self.legend.position() {
-            chart
-                .configure_series_labels()
-                .position(pos)
-                .label_font((FONT, 18))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .draw()?;
-        }
         Ok(())
     }
+}
+
+/// Log ticks, grid lines and labels by hand over the log10 ranges `x` and `y` (plotters'
+/// log axes skip the values below the first power of ten): bold at the labelled values.
+fn draw_log_grid<DB: DrawingBackend>(
+    chart: &mut Chart<DB>,
+    root: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> std::result::Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let label = TextStyle::from((FONT, 18).into_font()).color(&BLACK);
+    let grid = |bold: bool| BLACK.mix(if bold { 0.15 } else { 0.06 }).stroke_width(1);
+    for (v, bold) in log_ticks(x0, x1) {
+        let l = v.log10();
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(l, y0), (l, y1)],
+            grid(bold),
+        )))?;
+        let (px, py) = chart.backend_coord(&(l, y0));
+        let len = if bold { 6 } else { 3 };
+        root.draw(&PathElement::new(vec![(px, py), (px, py + len)], BLACK))?;
+        if bold {
+            let style = label.pos(Pos::new(HPos::Center, VPos::Top));
+            root.draw(&Text::new(log_tick(v), (px, py + 9), style))?;
+        }
+    }
+    for (v, bold) in log_ticks(y0, y1) {
+        let l = v.log10();
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(x0, l), (x1, l)],
+            grid(bold),
+        )))?;
+        let (px, py) = chart.backend_coord(&(x0, l));
+        let len = if bold { 6 } else { 3 };
+        root.draw(&PathElement::new(vec![(px - len, py), (px, py)], BLACK))?;
+        if bold {
+            let style = label.pos(Pos::new(HPos::Right, VPos::Center));
+            root.draw(&Text::new(log_tick(v), (px - 9, py), style))?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

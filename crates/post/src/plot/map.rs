@@ -1,7 +1,9 @@
 //! Maps of a 2D node cloud: every node a square of its spacing coloured by a value, with a
 //! colour bar, axes, optional region outlines, crack segments and heat-flux arrows.
 
-use super::{extent, plot_error, render, tick_label, widen, ColourMap, DrawError, Figure, FONT};
+use super::{
+    extent, plot_error, render, tick_label, widen, Chart, ColourMap, DrawError, Figure, FONT,
+};
 use peritherm_core::error::Result;
 use peritherm_core::math::{Point, Vector};
 use peritherm_core::spatial::PointIndex;
@@ -157,6 +159,58 @@ impl<'a> FieldMap<'a> {
 
 /// Draws `map` into `<stem>.png` and `<stem>.svg`, with equal scales on both axes.
 pub fn field_map(stem: &Path, map: &FieldMap) -> Result<()> {
+    check_map(stem, map)?;
+    let n = map.pos.len();
+    let range = match map.range {
+        Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && hi > lo) => {
+            return Err(plot_error(
+                stem,
+                format!("colour range {lo}..{hi} is empty or not finite"),
+            ))
+        }
+        Some(r) => r,
+        None => {
+            let (lo, hi) = extent(map.value.iter().copied());
+            widen(lo, hi)
+        }
+    };
+    if map.square.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
+        return Err(plot_error(stem, "the square size must be positive"));
+    }
+    let side = map
+        .square
+        .unwrap_or_else(|| square_side(map.pos, map.spacing));
+    let r = |i: usize| map.spacing[i] / 2.0;
+    let x = extent((0..n).flat_map(|i| [map.pos[i].x - r(i), map.pos[i].x + r(i)]));
+    let y = extent((0..n).flat_map(|i| [map.pos[i].y - r(i), map.pos[i].y + r(i)]));
+    // the plotting area aims at 760 px along the longer side, at least 240 px along the other
+    let aspect = (y.1 - y.0) / (x.1 - x.0);
+    let (pw, ph) = if aspect <= 1.0 {
+        (760.0, (760.0 * aspect).max(240.0))
+    } else {
+        ((680.0 / aspect).max(240.0), 680.0)
+    };
+    let width = pw as u32 + YL + 2 * MARGIN + BAR;
+    let note = if map.flux.is_some() { NOTE } else { 0 };
+    let height = ph as u32 + TITLE + XL + 2 * MARGIN + note;
+    let fig = MapFigure {
+        map,
+        range,
+        x,
+        y,
+        size: (width, height),
+        outlines: map
+            .regions
+            .map(|reg| outlines(map, reg))
+            .unwrap_or_default(),
+        side,
+    };
+    render(stem, &fig)
+}
+
+/// Checks that `map` has something to draw: one finite value, position and positive spacing
+/// per node, regions and flux (when given) for every node, finite crack ends.
+fn check_map(stem: &Path, map: &FieldMap) -> Result<()> {
     let n = map.pos.len();
     if n == 0 {
         return Err(plot_error(stem, "no nodes to draw"));
@@ -203,51 +257,7 @@ pub fn field_map(stem: &Path, map: &FieldMap) -> Result<()> {
     {
         return Err(plot_error(stem, "a crack segment has a non-finite end"));
     }
-    let range = match map.range {
-        Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && hi > lo) => {
-            return Err(plot_error(
-                stem,
-                format!("colour range {lo}..{hi} is empty or not finite"),
-            ))
-        }
-        Some(r) => r,
-        None => {
-            let (lo, hi) = extent(map.value.iter().copied());
-            widen(lo, hi)
-        }
-    };
-    if map.square.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
-        return Err(plot_error(stem, "the square size must be positive"));
-    }
-    let side = map
-        .square
-        .unwrap_or_else(|| square_side(map.pos, map.spacing));
-    let r = |i: usize| map.spacing[i] / 2.0;
-    let x = extent((0..n).flat_map(|i| [map.pos[i].x - r(i), map.pos[i].x + r(i)]));
-    let y = extent((0..n).flat_map(|i| [map.pos[i].y - r(i), map.pos[i].y + r(i)]));
-    // the plotting area aims at 760 px along the longer side, at least 240 px along the other
-    let aspect = (y.1 - y.0) / (x.1 - x.0);
-    let (pw, ph) = if aspect <= 1.0 {
-        (760.0, (760.0 * aspect).max(240.0))
-    } else {
-        ((680.0 / aspect).max(240.0), 680.0)
-    };
-    let width = pw as u32 + YL + 2 * MARGIN + BAR;
-    let note = if map.flux.is_some() { NOTE } else { 0 };
-    let height = ph as u32 + TITLE + XL + 2 * MARGIN + note;
-    let fig = MapFigure {
-        map,
-        range,
-        x,
-        y,
-        size: (width, height),
-        outlines: map
-            .regions
-            .map(|reg| outlines(map, reg))
-            .unwrap_or_default(),
-        side,
-    };
-    render(stem, &fig)
+    Ok(())
 }
 
 /// Edges of node squares that face a node of another region (region boundaries).
@@ -373,6 +383,58 @@ impl Figure for MapFigure<'_> {
         let (hx, hy) = (0.5 * per_px * pw as f64, 0.5 * per_px * ph as f64);
         let (xr, yr) = ((cx - hx, cx + hx), (cy - hy, cy + hy));
         let mut chart = build(xr, yr)?;
+        self.draw_squares(&mut chart, per_px)?;
+        let grey = RGBColor(70, 70, 70).stroke_width(1);
+        chart.draw_series(
+            self.outlines
+                .iter()
+                .map(|s| PathElement::new(s.to_vec(), grey)),
+        )?;
+        draw_cracks(&mut chart, map.cracks, per_px)?;
+        let front = RGBColor(150, 0, 20).stroke_width(2);
+        chart.draw_series(
+            map.isolines
+                .iter()
+                .map(|s| PathElement::new(vec![(s[0].x, s[0].y), (s[1].x, s[1].y)], front)),
+        )?;
+        let mut longest = 0.0;
+        if let Some(flux) = map.flux {
+            let (lines, qmax) = arrows(map, flux, self.x, self.y);
+            longest = qmax;
+            let ink = RGBColor(15, 15, 15).stroke_width(2);
+            chart.draw_series(lines.into_iter().map(|l| PathElement::new(l, ink)))?;
+        }
+        draw_axes(&mut chart, &map.length_unit, xr, yr)?;
+        let (_, main_y) = chart.plotting_area().get_pixel_range();
+        self.draw_colour_bar(&bar, main_y)?;
+        if let Some(note) = note {
+            let text = if longest > 0.0 {
+                format!(
+                    "Arrows: heat flux on a coarse grid of nodes, longest |q| = {} {}",
+                    super::sci(longest),
+                    map.flux_unit
+                )
+            } else {
+                "No arrows: the heat flux is zero at the sampled nodes".to_string()
+            };
+            let style = TextStyle::from((FONT, 17).into_font()).color(&BLACK);
+            note.draw(&Text::new(text, (YL as i32 + MARGIN as i32, 2), style))?;
+        }
+        Ok(())
+    }
+}
+
+impl MapFigure<'_> {
+    /// The node squares in their colours; `per_px` is the data length of one pixel.
+    fn draw_squares<DB: DrawingBackend>(
+        &self,
+        chart: &mut Chart<DB>,
+        per_px: f64,
+    ) -> std::result::Result<(), DrawError>
+    where
+        DB::ErrorType: 'static,
+    {
+        let map = self.map;
         let (lo, hi) = self.range;
         let pad = 0.5 * per_px; // half a pixel of overlap hides seams between squares
         chart.draw_series((0..map.pos.len()).map(|i| {
@@ -387,66 +449,25 @@ impl Figure for MapFigure<'_> {
                 map.colour_map.colour(map.value[i], lo, hi).filled(),
             )
         }))?;
-        let grey = RGBColor(70, 70, 70).stroke_width(1);
-        chart.draw_series(
-            self.outlines
-                .iter()
-                .map(|s| PathElement::new(s.to_vec(), grey)),
-        )?;
-        // cracks as filled bands 4 px wide (thick plotters lines leave pinholes)
-        chart.draw_series(map.cracks.iter().filter_map(|c| {
-            let (dx, dy) = (c[1].x - c[0].x, c[1].y - c[0].y);
-            let len = dx.hypot(dy);
-            (len > 0.0).then(|| {
-                let (nx, ny) = (-dy / len * 2.0 * per_px, dx / len * 2.0 * per_px);
-                let (tx, ty) = (dx / len * per_px, dy / len * per_px);
-                let (a, b) = ((c[0].x - tx, c[0].y - ty), (c[1].x + tx, c[1].y + ty));
-                Polygon::new(
-                    vec![
-                        (a.0 + nx, a.1 + ny),
-                        (b.0 + nx, b.1 + ny),
-                        (b.0 - nx, b.1 - ny),
-                        (a.0 - nx, a.1 - ny),
-                    ],
-                    BLACK.filled(),
-                )
-            })
-        }))?;
-        let front = RGBColor(150, 0, 20).stroke_width(2);
-        chart.draw_series(
-            map.isolines
-                .iter()
-                .map(|s| PathElement::new(vec![(s[0].x, s[0].y), (s[1].x, s[1].y)], front)),
-        )?;
-        let mut longest = 0.0;
-        if let Some(flux) = map.flux {
-            let (lines, qmax) = arrows(map, flux, self.x, self.y);
-            longest = qmax;
-            let ink = RGBColor(15, 15, 15).stroke_width(2);
-            chart.draw_series(lines.into_iter().map(|l| PathElement::new(l, ink)))?;
-        }
-        let unit = &map.length_unit;
-        let (xs, xl) = (xr.1 - xr.0, xr.0.abs().max(xr.1.abs()));
-        let (ys, yl) = (yr.1 - yr.0, yr.0.abs().max(yr.1.abs()));
-        let fx = |v: &f64| tick_label(*v, xs, xl);
-        let fy = |v: &f64| tick_label(*v, ys, yl);
-        chart
-            .configure_mesh()
-            .set_all_tick_mark_size(5)
-            .disable_mesh()
-            .x_desc(format!("x ({unit})"))
-            .y_desc(format!("y ({unit})"))
-            .label_style((FONT, 18))
-            .axis_desc_style((FONT, 20))
-            .x_label_formatter(&fx)
-            .y_label_formatter(&fy)
-            .draw()?;
-        // colour bar, as tall as the map less room for the min and max labels
-        let (_, main_y) = chart.plotting_area().get_pixel_range();
+        Ok(())
+    }
+
+    /// The colour bar in `bar`, as tall as the map (pixel rows `main_y`) less room for the
+    /// min and max labels.
+    fn draw_colour_bar<DB: DrawingBackend>(
+        &self,
+        bar: &DrawingArea<DB, Shift>,
+        main_y: std::ops::Range<i32>,
+    ) -> std::result::Result<(), DrawError>
+    where
+        DB::ErrorType: 'static,
+    {
+        let map = self.map;
+        let (lo, hi) = self.range;
         let bar_y = bar.get_pixel_range().1;
         let top = (main_y.start - bar_y.start + 24).max(0) as u32;
         let bottom = (bar_y.end - main_y.end + 24).max(0) as u32;
-        let mut cb = ChartBuilder::on(&bar)
+        let mut cb = ChartBuilder::on(bar)
             .margin_top(top)
             .margin_bottom(bottom)
             .margin_left(14)
@@ -488,22 +509,69 @@ impl Figure for MapFigure<'_> {
         bar.draw(&Text::new(
             format!("min {}", short(lo)),
             (x0, py.end - base.1 + 6),
-            style.clone(),
+            style,
         ))?;
-        if let Some(note) = note {
-            let text = if longest > 0.0 {
-                format!(
-                    "Arrows: heat flux on a coarse grid of nodes, longest |q| = {} {}",
-                    super::sci(longest),
-                    map.flux_unit
-                )
-            } else {
-                "No arrows: the heat flux is zero at the sampled nodes".to_string()
-            };
-            note.draw(&Text::new(text, (YL as i32 + MARGIN as i32, 2), style))?;
-        }
         Ok(())
     }
+}
+
+/// Cracks as filled bands 4 px wide (thick plotters lines leave pinholes); `per_px` is the
+/// data length of one pixel.
+fn draw_cracks<DB: DrawingBackend>(
+    chart: &mut Chart<DB>,
+    cracks: &[[Point; 2]],
+    per_px: f64,
+) -> std::result::Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    chart.draw_series(cracks.iter().filter_map(|c| {
+        let (dx, dy) = (c[1].x - c[0].x, c[1].y - c[0].y);
+        let len = dx.hypot(dy);
+        (len > 0.0).then(|| {
+            let (nx, ny) = (-dy / len * 2.0 * per_px, dx / len * 2.0 * per_px);
+            let (tx, ty) = (dx / len * per_px, dy / len * per_px);
+            let (a, b) = ((c[0].x - tx, c[0].y - ty), (c[1].x + tx, c[1].y + ty));
+            Polygon::new(
+                vec![
+                    (a.0 + nx, a.1 + ny),
+                    (b.0 + nx, b.1 + ny),
+                    (b.0 - nx, b.1 - ny),
+                    (a.0 - nx, a.1 - ny),
+                ],
+                BLACK.filled(),
+            )
+        })
+    }))?;
+    Ok(())
+}
+
+/// The x and y axes over the ranges `xr` and `yr`, labelled in `unit`.
+fn draw_axes<DB: DrawingBackend>(
+    chart: &mut Chart<DB>,
+    unit: &str,
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> std::result::Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let (xs, xl) = (xr.1 - xr.0, xr.0.abs().max(xr.1.abs()));
+    let (ys, yl) = (yr.1 - yr.0, yr.0.abs().max(yr.1.abs()));
+    let fx = |v: &f64| tick_label(*v, xs, xl);
+    let fy = |v: &f64| tick_label(*v, ys, yl);
+    chart
+        .configure_mesh()
+        .set_all_tick_mark_size(5)
+        .disable_mesh()
+        .x_desc(format!("x ({unit})"))
+        .y_desc(format!("y ({unit})"))
+        .label_style((FONT, 18))
+        .axis_desc_style((FONT, 20))
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .draw()?;
+    Ok(())
 }
 
 /// A value in four significant digits, without trailing zeros.

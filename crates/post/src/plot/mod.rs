@@ -77,6 +77,13 @@ pub fn palette(k: usize) -> RGBColor {
 /// Error type of the drawing code (plotters' errors, boxed).
 type DrawError = Box<dyn std::error::Error>;
 
+/// A chart with f64 coordinates on both axes (the maps' metres, the convergence plots' log10).
+type Chart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
 /// A picture that can be drawn on any plotters backend.
 trait Figure {
     /// Size of the image, pixels.

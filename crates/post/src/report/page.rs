@@ -296,22 +296,8 @@ pub fn write_report(
         .map(|k| summary.read_field(run, k))
         .collect::<Result<Vec<_>>>()?;
     let dim = case.spec.geometry.bare_cloud()?.dim;
-    let extra_fields = match extra {
-        Some((d, name)) => {
-            let s = RunSummary::read(d)?;
-            let mut by_output = Vec::new();
-            for t in &summary.output_times {
-                let k = s
-                    .output_times
-                    .iter()
-                    .position(|x| (x - t).abs() <= 1e-9 * t.abs());
-                by_output.push(match k {
-                    Some(k) => Some(s.read_field(d, k)?),
-                    None => None,
-                });
-            }
-            Some((by_output, name))
-        }
+    let extra = match extra {
+        Some((d, name)) => Some(ExtraRun::read(d, name, &summary)?),
         None => None,
     };
     let mut plots = Vec::new();
@@ -322,80 +308,15 @@ pub fn write_report(
             .into_owned()
     };
     if let Some(first) = fields.first() {
+        let lines = LinePlots {
+            summary: &summary,
+            fields: &fields,
+            extra: extra.as_ref(),
+            reference_name,
+            dir,
+        };
         for line in probe_lines(case, first, dim) {
-            let axis = ["x (m)", "y (m)", "z (m)"][line.along];
-            let mut temps = Vec::new();
-            let mut errors = Vec::new();
-            for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
-                let nodes = line.nodes(f);
-                if nodes.is_empty() {
-                    continue;
-                }
-                let pd: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, f.theta[i])).collect();
-                temps.push(
-                    Series::new(format!("PD, t = {} s", number_label(*t)), pd)
-                        .style(Style::Markers)
-                        .colour(k),
-                );
-                if let Some((by_output, name)) = &extra_fields {
-                    if let Some(Some(e)) = by_output.get(k) {
-                        let p: Vec<(f64, f64)> = line
-                            .nodes(e)
-                            .iter()
-                            .map(|&(i, s)| (s, e.theta[i]))
-                            .collect();
-                        if !p.is_empty() {
-                            temps.push(
-                                Series::new(format!("{name}, t = {} s", number_label(*t)), p)
-                                    .style(Style::Dashed)
-                                    .colour(k),
-                            );
-                        }
-                    }
-                }
-                if let Some(r) = &f.reference {
-                    let rf: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, r[i])).collect();
-                    temps.push(
-                        Series::new(format!("{reference_name}, t = {} s", number_label(*t)), rf)
-                            .style(Style::Line)
-                            .colour(k),
-                    );
-                    let e: Vec<(f64, f64)> =
-                        nodes.iter().map(|&(i, s)| (s, f.theta[i] - r[i])).collect();
-                    errors.push(
-                        Series::new(format!("t = {} s", number_label(*t)), e)
-                            .style(Style::LineMarkers)
-                            .colour(k),
-                    );
-                }
-            }
-            if temps.is_empty() {
-                continue;
-            }
-            let stem = dir.join(format!("line_{}", line.slug()));
-            line_plot(
-                &stem,
-                &Labels::new(
-                    format!("{}: temperature along {}", title(&summary), line.name),
-                    axis,
-                    "Temperature (°C)",
-                ),
-                &temps,
-                Legend::UpperLeft,
-            )?;
-            plots.push(stem_name(&stem));
-            if !errors.is_empty() {
-                let stem = dir.join(format!("error_{}", line.slug()));
-                line_plot(
-                    &stem,
-                    &Labels::new(
-                        format!("PD − {reference_name} along {}", line.name),
-                        axis,
-                        "Difference (°C)",
-                    ),
-                    &errors,
-                    Legend::UpperLeft,
-                )?;
+            for stem in lines.draw(&line)? {
                 plots.push(stem_name(&stem));
             }
         }
@@ -419,6 +340,138 @@ pub fn write_report(
     write_atomic(&dir.join("report.md"), md.as_bytes())?;
     write_atomic(&dir.join("index.html"), html.as_bytes())?;
     Ok(written)
+}
+
+/// Another finished run of the same case, drawn dashed along the probe lines.
+struct ExtraRun<'a> {
+    /// Its field at each output time of the report's run, when it has that time.
+    by_output: Vec<Option<FieldRows>>,
+    /// Its name in legends.
+    name: &'a str,
+}
+
+impl<'a> ExtraRun<'a> {
+    /// Reads the fields of the run in `dir` at the output times of `summary`.
+    fn read(dir: &Path, name: &'a str, summary: &RunSummary) -> Result<ExtraRun<'a>> {
+        let s = RunSummary::read(dir)?;
+        let mut by_output = Vec::new();
+        for t in &summary.output_times {
+            by_output.push(match s.output_index(*t) {
+                Some(k) => Some(s.read_field(dir, k)?),
+                None => None,
+            });
+        }
+        Ok(ExtraRun { by_output, name })
+    }
+}
+
+/// What the temperature and error plots along the probe lines of a report draw.
+struct LinePlots<'a> {
+    summary: &'a RunSummary,
+    /// The run's field at each output time.
+    fields: &'a [FieldRows],
+    extra: Option<&'a ExtraRun<'a>>,
+    reference_name: &'a str,
+    /// The report's directory.
+    dir: &'a Path,
+}
+
+impl LinePlots<'_> {
+    /// Draws the temperatures along `line` (and the difference to the reference, when the
+    /// fields carry one); returns the stems drawn, none when no node lies on the line.
+    fn draw(&self, line: &ProbeLine) -> Result<Vec<PathBuf>> {
+        let reference_name = self.reference_name;
+        let axis = ["x (m)", "y (m)", "z (m)"][line.along];
+        let (temps, errors) = self.series(line);
+        if temps.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut stems = Vec::new();
+        let stem = self.dir.join(format!("line_{}", line.slug()));
+        line_plot(
+            &stem,
+            &Labels::new(
+                format!("{}: temperature along {}", title(self.summary), line.name),
+                axis,
+                "Temperature (°C)",
+            ),
+            &temps,
+            Legend::UpperLeft,
+        )?;
+        stems.push(stem);
+        if !errors.is_empty() {
+            let stem = self.dir.join(format!("error_{}", line.slug()));
+            line_plot(
+                &stem,
+                &Labels::new(
+                    format!("PD − {reference_name} along {}", line.name),
+                    axis,
+                    "Difference (°C)",
+                ),
+                &errors,
+                Legend::UpperLeft,
+            )?;
+            stems.push(stem);
+        }
+        Ok(stems)
+    }
+
+    /// The temperature series along `line` (PD, the extra run, the reference at each output
+    /// time) and the PD − reference series.
+    fn series(&self, line: &ProbeLine) -> (Vec<Series>, Vec<Series>) {
+        let reference_name = self.reference_name;
+        let mut temps = Vec::new();
+        let mut errors = Vec::new();
+        for (k, (f, t)) in self
+            .fields
+            .iter()
+            .zip(&self.summary.output_times)
+            .enumerate()
+        {
+            let nodes = line.nodes(f);
+            if nodes.is_empty() {
+                continue;
+            }
+            let pd: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, f.theta[i])).collect();
+            temps.push(
+                Series::new(format!("PD, t = {} s", number_label(*t)), pd)
+                    .style(Style::Markers)
+                    .colour(k),
+            );
+            if let Some(extra) = self.extra {
+                if let Some(Some(e)) = extra.by_output.get(k) {
+                    let p: Vec<(f64, f64)> = line
+                        .nodes(e)
+                        .iter()
+                        .map(|&(i, s)| (s, e.theta[i]))
+                        .collect();
+                    if !p.is_empty() {
+                        temps.push(
+                            Series::new(format!("{}, t = {} s", extra.name, number_label(*t)), p)
+                                .style(Style::Dashed)
+                                .colour(k),
+                        );
+                    }
+                }
+            }
+            if let Some(r) = &f.reference {
+                let rf: Vec<(f64, f64)> = nodes.iter().map(|&(i, s)| (s, r[i])).collect();
+                temps.push(
+                    Series::new(format!("{reference_name}, t = {} s", number_label(*t)), rf)
+                        .style(Style::Line)
+                        .colour(k),
+                );
+                let e: Vec<(f64, f64)> =
+                    nodes.iter().map(|&(i, s)| (s, f.theta[i] - r[i])).collect();
+                errors.push(
+                    Series::new(format!("t = {} s", number_label(*t)), e)
+                        .style(Style::LineMarkers)
+                        .colour(k),
+                );
+            }
+        }
+        (temps, errors)
+    }
 }
 
 /// The settings table rows of a run: (setting, value).
