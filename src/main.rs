@@ -249,16 +249,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             json,
             command,
             fields,
-        } => {
-            use peritherm::figures::{table, TableKind};
-            let kind = if fields {
-                TableKind::Fields
-            } else {
-                TableKind::Accuracy
-            };
-            say!("{}", table(&runs, json.as_deref(), kind, &command)?);
-            Ok(())
-        }
+        } => table(&runs, json.as_deref(), fields, &command),
         Command::Compare {
             run,
             reference,
@@ -386,6 +377,24 @@ fn fem(
         out.display()
     );
     print_comparisons(&summary);
+    Ok(())
+}
+
+/// `peritherm table`: the accuracy (or, with `fields`, the fields) table of finished runs,
+/// also written as a figure file when `json` is given.
+fn table(
+    runs: &[PathBuf],
+    json: Option<&std::path::Path>,
+    fields: bool,
+    command: &str,
+) -> anyhow::Result<()> {
+    use peritherm::figures::TableKind;
+    let kind = if fields {
+        TableKind::Fields
+    } else {
+        TableKind::Accuracy
+    };
+    say!("{}", peritherm::figures::table(runs, json, kind, command)?);
     Ok(())
 }
 
