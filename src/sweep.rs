@@ -126,6 +126,8 @@ pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<
                 other => other,
             })?;
             let label = label(prefix, &settings);
+            let mut case = case;
+            case.settings = settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
             Ok(Variant {
                 label,
                 settings,
@@ -981,6 +983,8 @@ end = 0.01
         let v = variants(CASE, Path::new("bar.toml"), "", &vary).unwrap();
         assert_eq!(v.len(), 4);
         assert_eq!(v[1].label, "factor=2_cells=_40_");
+        let set = ["region.*.horizon.factor=2", "region.0.cells=[40]"];
+        assert_eq!(v[1].case.settings, set, "run.json lists the keys set");
         let cloud = v[1].case.spec.geometry.bare_cloud().unwrap();
         assert_eq!(cloud.n_body, 40);
         assert!((cloud.horizon[0] / cloud.spacing[0] - 2.0).abs() < 1e-12);
