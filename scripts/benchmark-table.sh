@@ -6,9 +6,15 @@
 # from it (scripts/update-docs.sh). Outputs go to out/bench/<case>/.
 # Usage: scripts/benchmark-table.sh [case-name ...]   (default: every case with a classical
 # reference; about 25 minutes on 2 cores)
+# PERITHERM=target/release/peritherm skips the build and uses that binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet
+if [ -n "${PERITHERM:-}" ]; then
+  bin=$PERITHERM
+else
+  cargo build --release --quiet
+  bin=./target/release/peritherm
+fi
 names=("$@")
 if [ ${#names[@]} -eq 0 ]; then
   names=(bar_dirichlet bar_flux bar_insulated_left
@@ -19,9 +25,9 @@ if [ ${#names[@]} -eq 0 ]; then
 fi
 dirs=()
 for n in "${names[@]}"; do
-  ./target/release/peritherm run "cases/$n.toml" --out "out/bench/$n" --quiet >&2
+  "$bin" run "cases/$n.toml" --out "out/bench/$n" --quiet >&2
   dirs+=("out/bench/$n")
 done
-./target/release/peritherm table "${dirs[@]}" --json validation/accuracy.json \
+"$bin" table "${dirs[@]}" --json validation/accuracy.json \
   --command "scripts/benchmark-table.sh"
 bash scripts/update-docs.sh

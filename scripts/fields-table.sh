@@ -5,9 +5,15 @@
 # (scripts/check-figures.sh), then the docs' blocks (scripts/update-docs.sh). A change that
 # should not touch the numerics must leave every figure of this file as it is.
 # Outputs go to out/fields/<case>/. Usage: bash scripts/fields-table.sh   (a few minutes on 2 cores)
+#   PERITHERM=target/release/peritherm   (skip the build, use this binary)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet
+if [ -n "${PERITHERM:-}" ]; then
+  bin=$PERITHERM
+else
+  cargo build --release --quiet
+  bin=./target/release/peritherm
+fi
 dirs=()
 for f in cases/*.toml; do
   n=$(basename "$f" .toml)
@@ -23,9 +29,9 @@ PY
 )
   args=()
   for s in $settings; do args+=(--set "$s"); done
-  ./target/release/peritherm run "$f" "${args[@]}" --out "out/fields/$n" --quiet >&2
+  "$bin" run "$f" "${args[@]}" --out "out/fields/$n" --quiet >&2
   dirs+=("out/fields/$n")
 done
-./target/release/peritherm table "${dirs[@]}" --fields --json validation/fields.json \
+"$bin" table "${dirs[@]}" --fields --json validation/fields.json \
   --command "scripts/fields-table.sh"
 bash scripts/update-docs.sh

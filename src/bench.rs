@@ -521,6 +521,25 @@ impl BenchReport {
         s
     }
 
+    /// The tables as figure files (`bench_bandwidth`, `bench_step`, `bench_setup` and, with
+    /// `--cases`, `bench_cases`), measured by `command`.
+    pub fn figures(&self, command: &str) -> Vec<peritherm_post::figures::Figures> {
+        use peritherm_post::figures::from_markdown;
+        let mut tables = vec![
+            ("bench_bandwidth", self.bandwidth_table()),
+            ("bench_step", self.step_table()),
+            ("bench_setup", self.setup_table()),
+        ];
+        if !self.cases.is_empty() {
+            tables.push(("bench_cases", self.cases_table()));
+        }
+        let provenance = crate::figures::provenance(self.threads);
+        let figure = |(name, table): (&str, String)| {
+            from_markdown(name, command, provenance.clone(), &table)
+        };
+        tables.into_iter().map(figure).collect()
+    }
+
     /// The bond updates per second that a bandwidth of `gbs` GB/s allows at
     /// [`BYTES_PER_BOND`].
     fn bond_limit(gbs: f64) -> f64 {

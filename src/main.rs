@@ -163,6 +163,13 @@ enum Command {
         /// repository root; minutes), writing their outputs into this directory.
         #[arg(long, value_name = "OUT_DIR")]
         cases: Option<PathBuf>,
+        /// Also write each table as a figure file bench_<table>.json into this directory (e.g.
+        /// validation/), with the commit and machine.
+        #[arg(long, value_name = "DIR")]
+        json: Option<PathBuf>,
+        /// The command that ran the measurement, recorded in the figure files.
+        #[arg(long, default_value = "peritherm bench")]
+        command: String,
     },
     /// Validate a case and print its size and stable time step without running it.
     Check {
@@ -278,6 +285,8 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             quick,
             nodes,
             cases,
+            json,
+            command,
         } => {
             let threads = cli.threads.unwrap_or_else(rayon::current_num_threads);
             let opts = peritherm::bench::BenchOptions {
@@ -286,9 +295,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
                 threads,
                 cases,
             };
-            let report = peritherm::bench::run(&opts, |line| eprintln!("bench: {line}"))?;
-            say!("{}", report.markdown());
-            Ok(())
+            bench(&opts, json.as_deref(), &command)
         }
         Command::Check { case } => check(&case, &options),
     }
@@ -395,6 +402,24 @@ fn table(
         TableKind::Accuracy
     };
     say!("{}", peritherm::figures::table(runs, json, kind, command)?);
+    Ok(())
+}
+
+/// `peritherm bench`: the tables printed and, with `json`, written as figure files there.
+fn bench(
+    opts: &peritherm::bench::BenchOptions,
+    json: Option<&std::path::Path>,
+    command: &str,
+) -> anyhow::Result<()> {
+    let report = peritherm::bench::run(opts, |line| eprintln!("bench: {line}"))?;
+    say!("{}", report.markdown());
+    if let Some(dir) = json {
+        for figures in report.figures(command) {
+            let path = dir.join(format!("{}.json", figures.name));
+            peritherm::atomic::write_atomic(&path, figures.to_json().as_bytes())?;
+            say!("-> {}", path.display());
+        }
+    }
     Ok(())
 }
 

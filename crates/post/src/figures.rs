@@ -201,6 +201,29 @@ impl Figures {
     }
 }
 
+/// A figure file from a Markdown table (`| a | b |` lines: the header, the separator, the
+/// rows; other lines are left out), for tables that a command prints, with no checks (speed
+/// figures depend on the machine).
+pub fn from_markdown(name: &str, command: &str, provenance: Provenance, table: &str) -> Figures {
+    let cells = |line: &str| -> Vec<String> {
+        let inner = line.trim().trim_start_matches('|').trim_end_matches('|');
+        inner.split('|').map(|c| c.trim().to_string()).collect()
+    };
+    let lines: Vec<&str> = table
+        .lines()
+        .filter(|l| l.trim_start().starts_with('|'))
+        .collect();
+    let columns = lines.first().map(|l| cells(l)).unwrap_or_default();
+    Figures {
+        name: name.into(),
+        command: command.into(),
+        provenance,
+        columns,
+        rows: lines.iter().skip(2).map(|l| cells(l)).collect(),
+        checks: Vec::new(),
+    }
+}
+
 /// Replaces the block `<!-- figures:NAME -->` … `<!-- /figures:NAME -->` of a Markdown text by
 /// `body`; None when the text has no such block.
 pub fn fill_block(doc: &str, name: &str, body: &str) -> Option<String> {
@@ -440,6 +463,17 @@ mod tests {
         assert_eq!(new, "a\n<!-- figures:t -->\nnew\n<!-- /figures:t -->\nb\n");
         assert_eq!(block_names(&new), vec!["t".to_string()]);
         assert!(fill_block(doc, "u", "x").is_none());
+    }
+
+    /// A printed Markdown table becomes the same table again.
+    #[test]
+    fn markdown_tables_round_trip() {
+        let p = Provenance::here("x".into(), 1);
+        let table = "| a | b |\n|---|---|\n| 1 | 2 |\n| 3 | 4 |\n";
+        let f = from_markdown("t", "c", p, &format!("intro\n{table}\nafter"));
+        assert_eq!(f.columns, ["a", "b"]);
+        assert_eq!(f.rows, [["1", "2"], ["3", "4"]]);
+        assert_eq!(f.table(), table);
     }
 
     /// NaN and infinities never pass; the tolerance is relative.
