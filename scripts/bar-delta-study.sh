@@ -7,12 +7,7 @@
 # PERITHERM=target/release/peritherm skips the build and uses that binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -n "${PERITHERM:-}" ]; then
-  bin=$PERITHERM
-else
-  cargo build --release --quiet
-  bin=./target/release/peritherm
-fi
+. scripts/peritherm-bin.sh
 "$bin" sweep cases/bar_dirichlet.toml \
   --vary 'region.*.horizon.radius=0.3,0.15,0.075,0.0375' --out out/bar-delta \
   --json validation/bar_delta.json --command scripts/bar-delta-study.sh

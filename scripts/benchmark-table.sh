@@ -9,12 +9,7 @@
 # PERITHERM=target/release/peritherm skips the build and uses that binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -n "${PERITHERM:-}" ]; then
-  bin=$PERITHERM
-else
-  cargo build --release --quiet
-  bin=./target/release/peritherm
-fi
+. scripts/peritherm-bin.sh
 names=("$@")
 if [ ${#names[@]} -eq 0 ]; then
   names=(bar_dirichlet bar_flux bar_insulated_left

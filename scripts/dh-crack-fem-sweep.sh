@@ -7,12 +7,7 @@
 # PERITHERM=target/release/peritherm skips the build and uses that binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -n "${PERITHERM:-}" ]; then
-  bin=$PERITHERM
-else
-  cargo build --release --quiet
-  bin=./target/release/peritherm
-fi
+. scripts/peritherm-bin.sh
 "$bin" sweep cases/dh_crack_plate_k1_m1.toml cases/dh_crack_plate_k1_m0.5.toml \
   cases/dh_crack_plate_k2_m1.toml cases/dh_crack_plate_k2_m2.toml --out out/dh-crack-sweep \
   --json validation/dh_crack_fem.json --command scripts/dh-crack-fem-sweep.sh

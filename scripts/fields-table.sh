@@ -8,12 +8,7 @@
 #   PERITHERM=target/release/peritherm   (skip the build, use this binary)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -n "${PERITHERM:-}" ]; then
-  bin=$PERITHERM
-else
-  cargo build --release --quiet
-  bin=./target/release/peritherm
-fi
+. scripts/peritherm-bin.sh
 dirs=()
 for f in cases/*.toml; do
   n=$(basename "$f" .toml)
