@@ -68,9 +68,9 @@ pub fn table(
     match json {
         Some(path) => {
             write_atomic(path, figures.to_json().as_bytes())?;
-            Ok(figures.markdown())
+            Ok(figures.markdown().trim_end().to_string())
         }
-        None => Ok(figures.table()),
+        None => Ok(figures.table().trim_end().to_string()),
     }
 }
 
