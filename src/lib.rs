@@ -27,6 +27,8 @@ pub use peritherm_io::{
 pub use peritherm_post::{plot, report};
 
 pub mod bench;
+#[cfg(feature = "mpi")]
+pub mod distributed;
 pub mod fem;
 pub mod figures;
 pub mod prepare;

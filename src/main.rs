@@ -204,10 +204,14 @@ macro_rules! say {
     }};
 }
 
+/// Set on the ranks of a distributed run other than 0: rank 0 reports the error.
+static SILENT: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match real_main(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(_) if SILENT.load(std::sync::atomic::Ordering::Relaxed) => ExitCode::FAILURE,
         Err(e) => {
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("error: {msg}");
@@ -323,6 +327,10 @@ fn run(
     quiet: bool,
     options: &peritherm::prepare::Options,
 ) -> anyhow::Result<()> {
+    #[cfg(feature = "mpi")]
+    if let Some(env) = peritherm::distributed::Environment::init() {
+        return run_mpi(&env, path, set, out, quiet, options);
+    }
     let case = peritherm::sweep::load_with(path, set)?;
     let bar = step_bar(quiet);
     let summary = run_case_with(&case, out, options, |done, total| {
@@ -330,6 +338,57 @@ fn run(
         bar.set_position(done);
     })?;
     bar.finish_and_clear();
+    print_run(&case, &summary, out);
+    Ok(())
+}
+
+/// `peritherm run` as one rank of `mpiexec -n N` (or a singleton, N = 1): each rank takes its
+/// share of the node's cores unless `--threads` says otherwise; rank 0 shows the progress,
+/// writes the outputs and prints; the other ranks print no error of their own.
+#[cfg(feature = "mpi")]
+fn run_mpi(
+    env: &peritherm::distributed::Environment,
+    path: &std::path::Path,
+    set: &[peritherm::sweep::Vary],
+    out: &std::path::Path,
+    quiet: bool,
+    options: &peritherm::prepare::Options,
+) -> anyhow::Result<()> {
+    let root = env.rank() == 0;
+    if !root {
+        SILENT.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+    // fails when --threads built the pool already: that choice stands
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(env.threads_per_rank())
+        .build_global();
+    let case = peritherm::sweep::load_with(path, set)?;
+    let bar = step_bar(quiet || !root);
+    let summary = env.run(&case, out, options, |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    if let Some(summary) = summary {
+        print_run(&case, &summary, out);
+        if let Some(r) = &summary.ranks {
+            say!(
+                "  {} ranks ({}): {}..{} nodes and {} ghosts each at most, {} B per halo exchange",
+                r.size,
+                r.mode,
+                r.nodes.iter().min().unwrap_or(&0),
+                r.nodes.iter().max().unwrap_or(&0),
+                r.ghosts.iter().max().unwrap_or(&0),
+                r.halo_bytes
+            );
+        }
+    }
+    Ok(())
+}
+
+/// What `run` prints of a finished run: sizes, steps, time, the implicit counters and the
+/// comparisons with the reference.
+fn print_run(case: &Case, summary: &RunSummary, out: &std::path::Path) {
     say!(
         "{}: {} nodes, {} bonds, {} steps of {:.3e} s in {:.2} s -> {}",
         case.path.display(),
@@ -352,8 +411,7 @@ fn run(
             st.factorisations
         );
     }
-    print_comparisons(&summary);
-    Ok(())
+    print_comparisons(summary);
 }
 
 /// `peritherm fem`: the classical FEM solve of the case into `out`, with its sizes, time

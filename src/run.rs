@@ -10,10 +10,11 @@ use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::operator::Conductance;
 use crate::output::read_field;
-use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, RunSummary};
+use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, Ranks, RunSummary};
 use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
+use crate::solve::exchange::{Exchange, RankPlan, Reduce};
 use crate::solve::{integrate, Engine, Integrator, RunStats, Schedule};
 use crate::staging::{reached, write_into};
 use std::path::Path;
@@ -50,11 +51,120 @@ pub fn run_model(
     let plan = plan(case, model)?;
     let name = case.path.display().to_string();
     write_into(out, &name, |dir| {
-        execute(case, model, plan, dir, t_setup, progress)
+        execute(case, model, plan, dir, t_setup, progress, None)
     })
 }
 
-/// The time loop of a planned run, writing into the staged directory `out`.
+/// One rank's part in a distributed run.
+pub struct Rank<'a> {
+    /// The communication with the other ranks.
+    pub exchange: &'a dyn Exchange,
+    /// Every rank's rows and halo ([`RankPlan::all`]).
+    pub plans: &'a [RankPlan],
+    /// `rows` when the stepper is distributed, `replicated` when every rank steps it all.
+    pub mode: &'static str,
+}
+
+/// Runs `case` on its built `model` as one rank of a distributed run over `exchange`
+/// (`plans`: every rank's rows and halo, [`RankPlan::all`]): explicit runs step their rows
+/// only ([`crate::solve::explicit::Explicit::distribute`]), the other steppers step the whole
+/// model on every rank. Rank 0 writes `out` as a serial run would, with the same bits, and
+/// returns the summary; the other ranks return None. A rank that fails stops all of them.
+pub fn run_ranked<'a>(
+    case: &Case,
+    model: &'a Model,
+    out: &Path,
+    t_setup: Instant,
+    exchange: &'a dyn Exchange,
+    plans: &'a [RankPlan],
+    progress: impl FnMut(u64, u64),
+) -> Result<Option<RunSummary>> {
+    let mut plan = plan(case, model)?;
+    let mode = match &mut plan.engine {
+        Engine::Explicit(e) => {
+            e.distribute(exchange);
+            "rows"
+        }
+        _ => "replicated",
+    };
+    let rank = Rank {
+        exchange,
+        plans,
+        mode,
+    };
+    if exchange.rank() != 0 {
+        return follow(case, model, plan, exchange).map(|_| None);
+    }
+    let mut entered = false;
+    let name = case.path.display().to_string();
+    let done = write_into(out, &name, |dir| {
+        entered = true;
+        execute(case, model, plan, dir, t_setup, progress, Some(&rank))
+    });
+    if !entered {
+        // the others wait for the start of the time loop: tell them it will not come
+        agree(Some(exchange), false);
+    }
+    done.map(Some)
+}
+
+/// True on every rank when `ok` on all ranks (a collective, [`Exchange::reduce`]); a
+/// serial run (no exchange) agrees with itself.
+fn agree(exchange: Option<&dyn Exchange>, ok: bool) -> bool {
+    match exchange {
+        Some(ex) => ex.reduce(if ok { 0.0 } else { 1.0 }, Reduce::Max) == 0.0,
+        None => ok,
+    }
+}
+
+/// The time loop of a rank other than 0: the same steps and collectives as rank 0's
+/// ([`execute`]), no output.
+fn follow(case: &Case, model: &Model, plan: Plan, exchange: &dyn Exchange) -> Result<()> {
+    let schedule = plan.schedule();
+    let Plan { mut engine, .. } = plan;
+    if !agree(Some(exchange), true) {
+        return Err(Error::Peer);
+    }
+    let times = case.times();
+    let mut theta = model.theta0.clone();
+    let peer = |ok: bool| if ok { Ok(()) } else { Err(Error::Peer) };
+    integrate(
+        &mut engine,
+        &schedule,
+        &mut theta,
+        0.0,
+        &times,
+        |_, _, _, _, _| peer(agree(Some(exchange), true)),
+        |_, _| {},
+    )?;
+    exchange.reduce(exchange.traffic().1, Reduce::Max);
+    Ok(())
+}
+
+/// Per-rank sizes of a distributed run for run.json (a collective: the longest exchange time
+/// is reduced over the ranks).
+fn ranks(model: &Model, rank: &Rank) -> Ranks {
+    let ex = rank.exchange;
+    let exchange_seconds = ex.reduce(ex.traffic().1, Reduce::Max);
+    let off = &model.conductance.offsets;
+    let rows = |p: &RankPlan| p.partition.range(p.rank);
+    Ranks {
+        size: rank.plans.len(),
+        mode: rank.mode.into(),
+        nodes: rank.plans.iter().map(|p| rows(p).len()).collect(),
+        ghosts: rank.plans.iter().map(|p| p.halo.ghosts()).collect(),
+        pairs: rank
+            .plans
+            .iter()
+            .map(|p| off[rows(p).end] - off[rows(p).start])
+            .collect(),
+        halo_bytes: rank.plans.iter().map(|p| p.halo.ghosts() * 8).sum(),
+        exchange_seconds,
+    }
+}
+
+/// The time loop of a planned run, writing into the staged directory `out`; as rank 0 of a
+/// distributed run when `rank` is given (the others [`follow`]).
 fn execute(
     case: &Case,
     model: &Model,
@@ -62,20 +172,25 @@ fn execute(
     out: &Path,
     t_setup: Instant,
     mut progress: impl FnMut(u64, u64),
+    rank: Option<&Rank>,
 ) -> Result<RunSummary> {
+    let ex = rank.map(|r| r.exchange);
     let schedule = plan.schedule();
     let Plan {
         total, mut engine, ..
     } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
-    // first, so that a run that fails or is interrupted also says which case it was
-    let origin = crate::provenance::write_copy(out, case)?;
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let t_run = Instant::now();
-    let started = Instant::now();
-    let mut writer = OutputWriter::new(case, model, out)?;
-    let fem_seconds = started.elapsed().as_secs_f64();
+    // first, so that a run that fails or is interrupted also says which case it was
+    let ready = crate::provenance::write_copy(out, case)
+        .and_then(|origin| Ok((origin, OutputWriter::new(case, model, out)?)));
+    if !agree(ex, ready.is_ok()) {
+        return Err(ready.err().unwrap_or(Error::Peer));
+    }
+    let (origin, mut writer) = ready?;
+    let fem_seconds = t_run.elapsed().as_secs_f64();
     let reference = writer.reference.clone();
     // the steppers stop at the outputs and at the history's samples
     let times = case.times();
@@ -86,9 +201,13 @@ fn execute(
         if let Some(r) = recorder.as_mut() {
             r.record(t, th);
         }
-        match output_index(&case.outputs, times[k]) {
+        let written = match output_index(&case.outputs, times[k]) {
             Some(f) => writer.write(f, t, th, conductance, e),
             None => Ok(()),
+        };
+        match (agree(ex, written.is_ok()), written) {
+            (false, Ok(())) => Err(Error::Peer),
+            (_, w) => w,
         }
     };
     let t_last = case.outputs.last().copied().unwrap_or(case.end);
@@ -110,6 +229,8 @@ fn execute(
         },
     )
     .map_err(|e| run_error(case, model, e))?;
+    // the last collective: whatever fails below fails on rank 0 alone
+    let ranks = rank.map(|r| ranks(model, r));
     let history = match &recorder {
         Some(r) => Some(r.write(out)?),
         None => None,
@@ -123,6 +244,7 @@ fn execute(
     summary.initial_energy = initial_energy;
     summary.history = history;
     summary.origin = Some(origin);
+    summary.ranks = ranks;
     summary.write(out)?;
     Ok(summary)
 }
@@ -204,6 +326,7 @@ fn summary(
         history: None,
         settings: case.settings.clone(),
         origin: None,
+        ranks: None,
     }
 }
 

@@ -702,6 +702,7 @@ fn write_recorded(
             history: None,
             settings: case.settings.clone(),
             origin: Some(origin),
+            ranks: None,
         };
         summary.write(dir)?;
         Ok(summary)

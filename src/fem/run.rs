@@ -159,6 +159,7 @@ fn solve(
         history: None,
         settings: case.settings.clone(),
         origin: Some(origin),
+        ranks: None,
     };
     summary.write(out)?;
     Ok(summary)

@@ -1,7 +1,8 @@
 //! Every bundled case parses, passes the validation path of `check` and `run`
 //! ([`peritherm::prepare`]: budget, model, semantic checks, and the plan of the time loop
 //! inside `run_model`), honours its own stability bound and runs a few steps (each model is
-//! built once and reused for the run).
+//! built once and reused for the run), and gives the same files distributed over 2 and 3
+//! ranks ([`crate::distributed`]).
 
 use peritherm::case::Case;
 use peritherm::run::run_model;
@@ -57,8 +58,11 @@ fn every_case_builds_and_starts() {
             assert_eq!(s.steps, 3, "{}", path.display());
         }
         assert!(out.path().join("field_1.csv").exists());
+        let serial_seconds = started.elapsed().as_secs_f64();
+        // and distributed over 2 and 3 ranks, the same bits
+        crate::distributed::same_as_serial(&case, &model, out.path(), serial_seconds);
         eprintln!(
-            "{}: {:.1} s",
+            "{}: {serial_seconds:.1} s, {:.1} s with the distributed runs",
             path.display(),
             started.elapsed().as_secs_f64()
         );

@@ -14,6 +14,7 @@ mod common {
 
 mod bundled;
 mod cracks;
+mod distributed;
 mod figures;
 mod implicit;
 mod phase;

@@ -49,6 +49,9 @@ pub enum Error {
         /// Simulation time, s.
         time: f64,
     },
+    /// Another rank of a distributed run stopped; the first rank reports why.
+    #[error("another rank of the distributed run stopped (rank 0 says why)")]
+    Peer,
     /// A linear solve of the implicit or steady solvers failed (theory §4).
     #[error("linear solver: {message}")]
     Solver {

@@ -24,6 +24,7 @@ pub mod mesh;
 pub mod model;
 pub mod neighbors;
 pub mod operator;
+pub mod partition;
 pub mod solve;
 pub mod spatial;
 pub mod stencil;

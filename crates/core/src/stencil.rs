@@ -9,6 +9,7 @@
 use crate::operator::{Conductance, ROW_CHUNK};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::ops::Range;
 
 /// The stencils of one block of rows.
 #[derive(Debug, Clone, Default)]
@@ -141,28 +142,41 @@ impl Stencils {
                 .sum::<usize>()
     }
 
-    /// Calls `f(i, Σ_j K_ij (θ_j − θ_i), out_i)` for every body row, block by block in parallel
-    /// (gather form: each row writes only its own slot of `out`).
+    /// Calls `f(i, Σ_j K_ij (θ_j − θ_i), out_i)` for every body row `i` of `rows`, block by
+    /// block in parallel (gather form: each row writes only its own slot of `out`, which holds
+    /// the rows `rows`).
     #[inline(always)]
     pub fn for_rows(
         &self,
         theta: &[f64],
         out: &mut [f64],
+        rows: Range<usize>,
         f: impl Fn(usize, f64, &mut f64) + Sync,
     ) {
-        out.par_chunks_mut(ROW_CHUNK)
-            .zip(self.blocks.par_iter())
-            .zip(self.row.par_chunks(ROW_CHUNK))
-            .enumerate()
-            .for_each(|(b, ((o, blk), ids))| {
-                let first = b * ROW_CHUNK;
-                for (r, (o, &s)) in o.iter_mut().zip(ids).enumerate() {
-                    let i = first + r;
-                    let e = blk.start[s as usize] as usize..blk.start[s as usize + 1] as usize;
-                    let flow =
-                        row_sum_delta(&blk.delta[e.clone()], &blk.vals[e], theta, i, theta[i]);
-                    f(i, flow, o);
-                }
-            });
+        let run = |first: usize, o: &mut [f64]| {
+            if o.is_empty() {
+                return;
+            }
+            let blk = &self.blocks[first / ROW_CHUNK];
+            for (r, o) in o.iter_mut().enumerate() {
+                let i = first + r;
+                let s = self.row[i] as usize;
+                let e = blk.start[s] as usize..blk.start[s + 1] as usize;
+                let flow = row_sum_delta(&blk.delta[e.clone()], &blk.vals[e], theta, i, theta[i]);
+                f(i, flow, o);
+            }
+        };
+        // the rows before the first block boundary, then whole blocks
+        let head = (rows.start.next_multiple_of(ROW_CHUNK)).min(rows.end) - rows.start;
+        let (first, rest) = out.split_at_mut(head);
+        let start = rows.start + head;
+        rayon::join(
+            || run(rows.start, first),
+            || {
+                rest.par_chunks_mut(ROW_CHUNK)
+                    .enumerate()
+                    .for_each(|(c, o)| run(start + c * ROW_CHUNK, o))
+            },
+        );
     }
 }

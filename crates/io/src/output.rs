@@ -418,6 +418,29 @@ pub struct RunSummary {
     /// Where the case came from ([`crate::provenance`]); absent in runs written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub origin: Option<CaseOrigin>,
+    /// A distributed run (`mpiexec -n N peritherm run`): what each rank held and exchanged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranks: Option<Ranks>,
+}
+
+/// What the ranks of a distributed run held and exchanged (run.json `ranks`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Ranks {
+    /// Number of ranks (the communicator's size).
+    pub size: usize,
+    /// `rows` (each rank steps its rows of K) or `replicated` (every rank steps the whole
+    /// model; the enthalpy and implicit steppers are not distributed yet).
+    pub mode: String,
+    /// Body nodes (rows) of each rank.
+    pub nodes: Vec<usize>,
+    /// Ghost body nodes each rank receives per exchange.
+    pub ghosts: Vec<usize>,
+    /// Pairs of K in each rank's rows.
+    pub pairs: Vec<usize>,
+    /// Bytes all ranks receive per halo exchange (an Euler step has one, RK4 four), B.
+    pub halo_bytes: usize,
+    /// Longest time any rank spent in halo exchanges, s.
+    pub exchange_seconds: f64,
 }
 
 fn peridynamics() -> String {

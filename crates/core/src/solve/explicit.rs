@@ -8,55 +8,51 @@
 use crate::error::Result;
 use crate::model::Model;
 use crate::operator::{row_sum, Conductance, ROW_CHUNK};
+use crate::solve::exchange::{Exchange, Reduce};
 use crate::stencil::Stencils;
 use rayon::prelude::*;
 use std::borrow::Cow;
+use std::ops::Range;
 
 // the integrator and the stepping interface under their old paths
 pub use crate::solve::integrator::{choose_dt, count_steps, steps_between, Integrator};
 pub use crate::solve::stepper::{check_finite, RunStats};
 use crate::solve::stepper::{march, Stepper};
 
-fn rates(model: &Model, k: &Conductance, theta: &[f64], t: f64, out: &mut [f64]) {
-    rates_with(model, k, None, theta, t, out);
+fn rates(
+    model: &Model,
+    k: &Conductance,
+    theta: &[f64],
+    t: f64,
+    rows: Range<usize>,
+    out: &mut [f64],
+) {
+    rates_with(model, k, None, theta, t, rows, out);
 }
 
-/// [`rates`] through the stencils of K when there are some (the same bits).
+/// The rate of every body row of `rows` into `out` (every body node; the other rows are left
+/// as they are, or set by the loads), through the stencils of K when there are some (the
+/// same bits), K/s.
 fn rates_with(
     model: &Model,
     k: &Conductance,
     stencils: Option<&Stencils>,
     theta: &[f64],
     t: f64,
+    rows: Range<usize>,
     out: &mut [f64],
 ) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
+    let mine = &mut out[rows.clone()];
     if let Some(st) = stencils {
-        st.for_rows(theta, out, |i, s, o| {
+        st.for_rows(theta, mine, rows, |i, s, o| {
             *o = if driven[i] { 0.0 } else { s * inv[i] };
         });
     } else {
-        out.par_chunks_mut(ROW_CHUNK)
-            .enumerate()
-            .for_each(|(c, o)| {
-                let first = c * ROW_CHUNK;
-                let rows = first..first + o.len();
-                let off = &k.offsets[first..=rows.end];
-                for ((((o, w), &d), &inv), &ti) in o
-                    .iter_mut()
-                    .zip(off.windows(2))
-                    .zip(&driven[rows.clone()])
-                    .zip(&inv[rows.clone()])
-                    .zip(&theta[rows])
-                {
-                    *o = if d {
-                        0.0
-                    } else {
-                        row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti) * inv
-                    };
-                }
-            });
+        csr_rows(k, theta, rows, mine, |i, s, _, o| {
+            *o = if driven[i] { 0.0 } else { s * inv[i] };
+        });
     }
     if model.boundary.has_loads() {
         model
@@ -70,48 +66,55 @@ fn rates_with(
     }
 }
 
-/// One fused forward-Euler update of the body nodes, gather form: `next_i = θ_i + h·Σ_j K_ij
-/// (θ_j − θ_i)/(V_i ρc_i)` for free nodes, `θ_i` for driven ones (the boundary sets them
-/// after). The same bits as [`rates`] followed by `θ_i += h·rate_i`, in one pass; through the
-/// stencils of K when there are some.
+/// Calls `f(i, Σ_j K_ij (θ_j − θ_i), θ_i, out_i)` for every body row `i` of `rows` through the
+/// plain CSR rows of K, in parallel tasks of [`ROW_CHUNK`] rows (`out` holds the rows `rows`).
+#[inline(always)]
+fn csr_rows(
+    k: &Conductance,
+    theta: &[f64],
+    rows: Range<usize>,
+    out: &mut [f64],
+    f: impl Fn(usize, f64, f64, &mut f64) + Sync,
+) {
+    out.par_chunks_mut(ROW_CHUNK)
+        .enumerate()
+        .for_each(|(c, o)| {
+            let first = rows.start + c * ROW_CHUNK;
+            let off = &k.offsets[first..=first + o.len()];
+            for (r, (o, w)) in o.iter_mut().zip(off.windows(2)).enumerate() {
+                let i = first + r;
+                let ti = theta[i];
+                let s = row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti);
+                f(i, s, ti, o);
+            }
+        });
+}
+
+/// One fused forward-Euler update of the body rows `rows`, gather form: `next_i = θ_i +
+/// h·Σ_j K_ij (θ_j − θ_i)/(V_i ρc_i)` for free nodes, `θ_i` for driven ones (the boundary sets
+/// them after), into `next` (the rows `rows`). The same bits as [`rates`] followed by
+/// `θ_i += h·rate_i`, in one pass; through the stencils of K when there are some.
 fn euler_fused(
     model: &Model,
     k: &Conductance,
     stencils: Option<&Stencils>,
     theta: &[f64],
     h: f64,
+    rows: Range<usize>,
     next: &mut [f64],
 ) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
     if let Some(st) = stencils {
-        st.for_rows(theta, next, |i, s, o| {
+        st.for_rows(theta, next, rows, |i, s, o| {
             let ti = theta[i];
             *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
         });
         return;
     }
-    next.par_chunks_mut(ROW_CHUNK)
-        .enumerate()
-        .for_each(|(c, o)| {
-            let first = c * ROW_CHUNK;
-            let rows = first..first + o.len();
-            let off = &k.offsets[first..=rows.end];
-            for ((((o, w), &d), &inv), &ti) in o
-                .iter_mut()
-                .zip(off.windows(2))
-                .zip(&driven[rows.clone()])
-                .zip(&inv[rows.clone()])
-                .zip(&theta[rows])
-            {
-                *o = if d {
-                    ti
-                } else {
-                    let s = row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti);
-                    ti + h * (s * inv)
-                };
-            }
-        });
+    csr_rows(k, theta, rows, next, |i, s, ti, o| {
+        *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
+    });
 }
 
 /// Explicit integrator state with preallocated buffers.
@@ -126,6 +129,10 @@ pub struct Explicit<'a> {
     stage: Vec<f64>,
     /// K as shared stencils for the Euler step (lattice clouds without growing cracks).
     stencils: Option<Stencils>,
+    /// The body rows this stepper computes: all, or a rank's in a distributed run.
+    rows: Range<usize>,
+    /// The other ranks of a distributed run.
+    exchange: Option<&'a dyn Exchange>,
 }
 
 impl<'a> Explicit<'a> {
@@ -159,7 +166,18 @@ impl<'a> Explicit<'a> {
                 Integrator::Euler if model.growth.is_empty() => Stencils::build(&model.conductance),
                 _ => None,
             },
+            rows: 0..nb,
+            exchange: None,
         }
+    }
+
+    /// Makes this stepper one rank of a distributed run: it computes the rows of
+    /// `exchange` and fills its ghosts from the other ranks before every boundary
+    /// application; at outputs ([`Stepper::settle`]) every rank holds the whole field. The
+    /// temperatures have the same bits as a serial run's (each row keeps its order).
+    pub fn distribute(&mut self, exchange: &'a dyn Exchange) {
+        self.rows = exchange.rows();
+        self.exchange = Some(exchange);
     }
 
     /// Turns the stencils of K ([`crate::stencil`]) on or off for the Euler step and tells
@@ -213,7 +231,12 @@ impl<'a> Explicit<'a> {
         self.cut_until(t);
         let m = self.model;
         let k = &*self.conductance;
-        let nb = m.cloud.n_body;
+        let rows = self.rows.clone();
+        // built from the model's K: not used once something owns a copy of K to change it
+        let st = match self.conductance {
+            Cow::Borrowed(_) => self.stencils.as_ref(),
+            Cow::Owned(_) => None,
+        };
         match self.integrator {
             Integrator::BackwardEuler
             | Integrator::CrankNicolson
@@ -222,57 +245,71 @@ impl<'a> Explicit<'a> {
                 panic!("implicit integrators run through solve::implicit, not Explicit")
             }
             Integrator::Euler if m.boundary.has_loads() => {
-                // built from the model's K: not used once something owns a copy of K to change it
-                let st = match self.conductance {
-                    Cow::Borrowed(_) => self.stencils.as_ref(),
-                    Cow::Owned(_) => None,
-                };
-                rates_with(m, k, st, theta, t, &mut self.k[0]);
-                theta[..nb]
-                    .par_chunks_mut(ROW_CHUNK)
-                    .zip(self.k[0].par_chunks(ROW_CHUNK))
-                    .for_each(|(y, r)| {
-                        for (y, r) in y.iter_mut().zip(r) {
-                            *y += h * r;
-                        }
-                    });
+                rates_with(m, k, st, theta, t, rows.clone(), &mut self.k[0]);
+                update(&mut theta[rows.clone()], &self.k[0][rows], |y, r| {
+                    *y += h * r
+                });
             }
             Integrator::Euler => {
                 // the new body temperatures into k[0], then back into θ (the caller's slice)
-                // built from the model's K: not used once something owns a copy of K to change it
-                let st = match self.conductance {
-                    Cow::Borrowed(_) => self.stencils.as_ref(),
-                    Cow::Owned(_) => None,
-                };
-                euler_fused(m, k, st, theta, h, &mut self.k[0]);
-                theta[..nb]
-                    .par_chunks_mut(ROW_CHUNK)
-                    .zip(self.k[0].par_chunks(ROW_CHUNK))
-                    .for_each(|(y, n)| y.copy_from_slice(n));
+                euler_fused(
+                    m,
+                    k,
+                    st,
+                    theta,
+                    h,
+                    rows.clone(),
+                    &mut self.k[0][rows.clone()],
+                );
+                update(&mut theta[rows.clone()], &self.k[0][rows], |y, n| *y = n);
             }
-            Integrator::Rk4 => {
-                let [k1, k2, k3, k4] = &mut self.k;
-                let stage = &mut self.stage;
-                rates(m, k, theta, t, k1);
-                stage.copy_from_slice(theta);
-                axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k1);
-                m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
-                rates(m, k, stage, t + 0.5 * h, k2);
-                axpy(&mut stage[..nb], &theta[..nb], 0.5 * h, k2);
-                m.boundary.apply(&m.cloud, stage, t + 0.5 * h);
-                rates(m, k, stage, t + 0.5 * h, k3);
-                axpy(&mut stage[..nb], &theta[..nb], h, k3);
-                m.boundary.apply(&m.cloud, stage, t + h);
-                rates(m, k, stage, t + h, k4);
-                let h6 = h / 6.0;
-                theta[..nb]
-                    .par_iter_mut()
-                    .with_min_len(4096)
-                    .enumerate()
-                    .for_each(|(i, y)| *y += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]));
-            }
+            Integrator::Rk4 => self.rk4(theta, t, h),
         }
-        m.boundary.apply(&m.cloud, theta, t + h);
+        constrain(m, self.exchange, theta, t + h);
+    }
+
+    /// One classical RK4 step of the rows of this stepper (the constraints set at each stage).
+    fn rk4(&mut self, theta: &mut [f64], t: f64, h: f64) {
+        let (m, k, rows, ex) = (
+            self.model,
+            &*self.conductance,
+            self.rows.clone(),
+            self.exchange,
+        );
+        let [k1, k2, k3, k4] = &mut self.k;
+        let r = rows.clone();
+        let mut stage = std::mem::take(&mut self.stage);
+        rates(m, k, theta, t, r.clone(), k1);
+        stage.copy_from_slice(theta);
+        axpy(
+            &mut stage[r.clone()],
+            &theta[r.clone()],
+            0.5 * h,
+            &k1[r.clone()],
+        );
+        constrain(m, ex, &mut stage, t + 0.5 * h);
+        rates(m, k, &stage, t + 0.5 * h, r.clone(), k2);
+        axpy(
+            &mut stage[r.clone()],
+            &theta[r.clone()],
+            0.5 * h,
+            &k2[r.clone()],
+        );
+        constrain(m, ex, &mut stage, t + 0.5 * h);
+        rates(m, k, &stage, t + 0.5 * h, r.clone(), k3);
+        axpy(&mut stage[r.clone()], &theta[r.clone()], h, &k3[r.clone()]);
+        constrain(m, ex, &mut stage, t + h);
+        rates(m, k, &stage, t + h, r.clone(), k4);
+        let h6 = h / 6.0;
+        theta[rows.clone()]
+            .par_iter_mut()
+            .with_min_len(4096)
+            .zip(&k1[rows.clone()])
+            .zip(&k2[rows.clone()])
+            .zip(&k3[rows.clone()])
+            .zip(&k4[rows])
+            .for_each(|((((y, a), b), c), d)| *y += h6 * (a + 2.0 * (b + c) + d));
+        self.stage = stage;
     }
 
     /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K)` there and
@@ -309,7 +346,29 @@ impl Stepper for Explicit<'_> {
         self.step(theta, t, h);
         Ok(())
     }
+    fn check(&self, theta: &[f64], t: f64) -> Result<()> {
+        let Some(ex) = self.exchange else {
+            return check_finite(theta, self.model.cloud.n_body, t);
+        };
+        // the first non-finite node over all ranks, so that every rank stops together
+        let rows = self.rows.clone();
+        let local = theta[rows.clone()]
+            .iter()
+            .position(|v| !v.is_finite())
+            .map_or(f64::INFINITY, |p| (rows.start + p) as f64);
+        match ex.reduce(local, Reduce::Min) {
+            node if node.is_finite() => Err(crate::Error::NonFinite {
+                node: node as usize,
+                time: t,
+            }),
+            _ => Ok(()),
+        }
+    }
     fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        if let Some(ex) = self.exchange {
+            // every rank takes the whole field: the output, energy and NaN check are serial's
+            ex.all_gather(theta);
+        }
         check_finite(theta, self.model.cloud.n_body, t)?;
         self.cut_until(t);
         Ok(())
@@ -320,6 +379,26 @@ impl Stepper for Explicit<'_> {
     fn energy_now(&self, theta: &[f64]) -> f64 {
         self.model.energy(theta)
     }
+}
+
+/// Fills the ghosts of `theta` (distributed runs), then sets its constrained and fictitious
+/// nodes at `t` (s).
+fn constrain(model: &Model, exchange: Option<&dyn Exchange>, theta: &mut [f64], t: f64) {
+    if let Some(ex) = exchange {
+        ex.halo(theta);
+    }
+    model.boundary.apply(&model.cloud, theta, t);
+}
+
+/// `f(y_i, x_i)` for every entry, in parallel tasks of [`ROW_CHUNK`].
+fn update(y: &mut [f64], x: &[f64], f: impl Fn(&mut f64, f64) + Sync) {
+    y.par_chunks_mut(ROW_CHUNK)
+        .zip(x.par_chunks(ROW_CHUNK))
+        .for_each(|(y, x)| {
+            for (y, &x) in y.iter_mut().zip(x) {
+                f(y, x);
+            }
+        });
 }
 
 fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {

@@ -3,6 +3,7 @@
 //! times ([`march`], [`integrate`]).
 
 pub mod enthalpy;
+pub mod exchange;
 pub mod explicit;
 pub mod implicit;
 pub mod integrator;

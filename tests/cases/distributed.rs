@@ -1,0 +1,77 @@
+//! A distributed run gives the serial run's files, bit for bit: ranks simulated by threads of
+//! one process ([`InProcess`], the protocol of the MPI build without MPI). Called for every
+//! bundled case by [`crate::bundled`]; the MPI build's own tests run the same under `mpiexec`.
+
+use peritherm::case::Case;
+use peritherm::model::Model;
+use peritherm::run::run_ranked;
+use peritherm::solve::exchange::{InProcess, RankPlan};
+use std::path::Path;
+use std::time::Instant;
+
+/// Runs `case` on `model` over `ranks` in-process ranks into `out`; rank 0's summary.
+pub fn run_in_process(
+    case: &Case,
+    model: &Model,
+    ranks: usize,
+    out: &Path,
+) -> peritherm::output::RunSummary {
+    let plans = RankPlan::all(model, ranks);
+    let group = InProcess::group(plans.clone(), model.cloud.len());
+    let plans = &plans;
+    let summaries: Vec<_> = std::thread::scope(|s| {
+        let handles: Vec<_> = group
+            .iter()
+            .map(|ex| {
+                s.spawn(move || run_ranked(case, model, out, Instant::now(), ex, plans, |_, _| {}))
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let mut summaries = summaries.into_iter();
+    let first = summaries.next().unwrap().unwrap_or_else(|e| panic!("{e}"));
+    for other in summaries {
+        assert!(other.unwrap_or_else(|e| panic!("{e}")).is_none());
+    }
+    first.expect("rank 0 writes the summary")
+}
+
+/// The files `serial` wrote for its fields (CSV and VTU), read from `serial_dir` and
+/// `other_dir`, are equal byte for byte.
+pub fn same_fields(serial_dir: &Path, other_dir: &Path, fields: &[String], what: &str) {
+    for f in fields {
+        let vtu = f.replace(".csv", ".vtu");
+        for name in [f.as_str(), vtu.as_str()] {
+            let a = std::fs::read(serial_dir.join(name)).unwrap();
+            let b = std::fs::read(other_dir.join(name)).unwrap();
+            assert!(a == b, "{what}: {name} differs from the serial run's");
+        }
+    }
+}
+
+/// Runs `case` distributed over 2 and 3 in-process ranks and checks the fields against the
+/// serial run in `serial_dir` (run.json lists them). Steppers that are not distributed (each
+/// rank steps the whole model) run over 2 ranks when their serial run took under a second
+/// (`serial_seconds`): the protocol around them is the same for all.
+pub fn same_as_serial(case: &Case, model: &Model, serial_dir: &Path, serial_seconds: f64) {
+    let serial = peritherm::output::RunSummary::read(serial_dir).unwrap();
+    let explicit = model.enthalpy.is_none() && !case.integrator.is_implicit();
+    let ranks: &[usize] = match (explicit, serial_seconds < 1.0) {
+        (true, _) => &[2, 3],
+        (false, true) => &[2],
+        (false, false) => &[],
+    };
+    for &ranks in ranks {
+        let out = tempfile::tempdir().unwrap();
+        let s = run_in_process(case, model, ranks, out.path());
+        let r = s.ranks.as_ref().expect("ranks in run.json");
+        assert_eq!(r.size, ranks);
+        assert_eq!(r.nodes.iter().sum::<usize>(), model.cloud.n_body);
+        let what = format!("{} on {ranks} ranks ({})", case.path.display(), r.mode);
+        same_fields(serial_dir, out.path(), &serial.fields, &what);
+        // both as run.json has them (serde_json's parse of a float may differ in its last bit
+        // from the value written, the same way for both)
+        let read = peritherm::output::RunSummary::read(out.path()).unwrap();
+        assert_eq!(read.energy, serial.energy, "{what}");
+    }
+}

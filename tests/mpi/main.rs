@@ -1,0 +1,155 @@
+//! Distributed runs under `mpiexec` (the `mpi` build only: `cargo test --release --features
+//! mpi --test mpi`, with MPICH or Open MPI installed). Each run is launched as
+//! `mpiexec -n N peritherm run ...` for N = 1, 2 and 3 (3 oversubscribes a 2-core machine),
+//! asserts the communicator size it ran on (run.json `ranks.size`) and compares its fields
+//! with a serial run of the same binary on one thread, byte for byte.
+//!
+//! The in-process ranks of `tests/cases/distributed.rs` check every bundled case with the same
+//! protocol without MPI; `scripts/mpi-check.sh` runs every bundled case under `mpiexec`.
+
+#[path = "../common"]
+#[allow(dead_code)]
+mod common {
+    pub mod cli;
+}
+
+use common::cli::{command, EXE};
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// `mpiexec -n ranks peritherm --threads 1 args...` to its end: one thread per rank, as the
+/// serial run it is compared with (the consistent weights' and the FEM reference's sparse
+/// Cholesky factorisations are not the same bits on every thread count).
+fn mpiexec(ranks: usize, args: &[&str]) -> Output {
+    Command::new("mpiexec")
+        .args(["-n", &ranks.to_string(), EXE, "--threads", "1"])
+        .args(args)
+        .output()
+        .expect("mpiexec (install MPICH: `apt-get install mpich libmpich-dev libclang-dev`)")
+}
+
+/// The settings that shorten a bundled case to a hundredth of its first output (as the
+/// fields figure does), three steps at least.
+fn short(case: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(case).unwrap();
+    let table: toml::Table = text.parse().unwrap();
+    let time = table["time"].as_table().unwrap();
+    let first = match time.get("outputs") {
+        Some(o) => o.as_array().unwrap()[0].as_float().unwrap(),
+        None => time["end"].as_float().unwrap(),
+    };
+    let end = first / 100.0;
+    let mut set = vec![
+        format!("time.end={end:?}"),
+        format!("time.outputs=[{end:?}]"),
+    ];
+    if time
+        .get("dt")
+        .and_then(|d| d.as_float())
+        .is_some_and(|dt| dt > end / 3.0)
+    {
+        set.push(format!("time.dt={:?}", end / 3.0));
+    }
+    set
+}
+
+/// Runs `case` shortened serially on one thread into `dir/serial`, then under `mpiexec -n
+/// 1, 2, 3` into `dir/ranks-N`, and compares.
+fn same_under_mpiexec(case: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases")
+        .join(case);
+    let dir = tempfile::tempdir().unwrap();
+    let mut args: Vec<String> = vec!["run".into(), path.display().to_string(), "-q".into()];
+    for s in short(&path) {
+        args.extend(["--set".into(), s]);
+    }
+    let with_out = |out: &Path| {
+        let mut a = args.clone();
+        a.extend(["--out".into(), out.display().to_string()]);
+        a
+    };
+    let serial = dir.path().join("serial");
+    let o = command()
+        .arg("--threads")
+        .arg("1")
+        .args(with_out(&serial))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{case}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let fields = peritherm::output::RunSummary::read(&serial).unwrap().fields;
+    for ranks in [1, 2, 3] {
+        let out = dir.path().join(format!("ranks-{ranks}"));
+        let a = with_out(&out);
+        let o = mpiexec(ranks, &a.iter().map(String::as_str).collect::<Vec<_>>());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{case} on {ranks} ranks: {err}");
+        let s = peritherm::output::RunSummary::read(&out).unwrap();
+        let r = s.ranks.expect("run.json of an MPI run lists its ranks");
+        assert_eq!(r.size, ranks, "{case}: the communicator's size");
+        assert_eq!(r.nodes.iter().sum::<usize>(), s.nodes, "{case}");
+        for f in &fields {
+            for name in [f.clone(), f.replace(".csv", ".vtu")] {
+                let a = std::fs::read(serial.join(&name)).unwrap();
+                let b = std::fs::read(out.join(&name)).unwrap();
+                assert!(
+                    a == b,
+                    "{case} on {ranks} ranks ({}): {name} differs",
+                    r.mode
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn explicit_cases_give_the_serial_bits() {
+    // Euler and RK4; a crack, growing cracks, dual horizon, a gmsh cloud, a flux relation,
+    // loads (a laser source and convection), a sphere
+    for case in [
+        "bar_flux.toml",
+        "crack_plate_uniform.toml",
+        "growing_cracks.toml",
+        "dh_plate_k0.5_m1.toml",
+        "dh_plate_gmsh_k0.5_m1.toml",
+        "laser_film.toml",
+        "sphere_cooling.toml",
+    ] {
+        same_under_mpiexec(case);
+    }
+}
+
+#[test]
+fn replicated_steppers_give_the_serial_bits() {
+    // phase change (enthalpy) and an implicit scheme: every rank steps the whole model
+    for case in ["ice_in_water.toml", "pipe_freezing.toml"] {
+        same_under_mpiexec(case);
+    }
+}
+
+#[test]
+fn a_bad_case_fails_once_on_every_rank_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("bad.toml");
+    std::fs::write(&case, "title = \"x\"\n[time]\nend = -1\n").unwrap();
+    let out = dir.path().join("out");
+    let o = mpiexec(
+        2,
+        &[
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(lines.len(), 1, "one error line from rank 0: {err}");
+    assert!(lines[0].contains("bad.toml"), "{err}");
+    assert!(!out.exists(), "no output directory");
+}
