@@ -426,7 +426,7 @@ fn bench(
 /// `peritherm check`: everything `run` does before its time loop (the budget, the model, the
 /// semantic checks, the step and its count, the steppers' set-up), and the sizes.
 fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyhow::Result<()> {
-    use peritherm::solve::explicit::Integrator;
+    use peritherm::solve::Integrator;
     let case = Case::load(path)?;
     say!("{}: {}", case.path.display(), case.budget.line());
     let model = peritherm::prepare::build(&case, options)?;

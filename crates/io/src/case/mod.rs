@@ -30,7 +30,7 @@ use peritherm_core::expr::Expr;
 use peritherm_core::material::Material;
 use peritherm_core::math::Point;
 use peritherm_core::model::{Geometry, ModelSpec};
-use peritherm_core::solve::explicit::Integrator;
+use peritherm_core::solve::Integrator;
 use peritherm_core::symmetry::Symmetry;
 use serde::Deserialize;
 use std::collections::BTreeMap;
