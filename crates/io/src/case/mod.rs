@@ -306,6 +306,34 @@ impl<'a> Ctx<'a> {
         }
     }
 
+    /// The value of the one key given among `options` (each key's value, None where it is
+    /// absent), of keys of which at most one may be given: None when none is, and the error
+    /// `several` (dotted key, message) when more than one is.
+    fn at_most_one<T, const N: usize>(
+        &self,
+        options: [Option<T>; N],
+        several: (&str, &str),
+    ) -> Result<Option<T>> {
+        let mut given = options.into_iter().flatten();
+        let one = given.next();
+        match given.next() {
+            Some(_) => Err(self.err(several.0, several.1)),
+            None => Ok(one),
+        }
+    }
+
+    /// [`Ctx::at_most_one`] of keys one of which must be given: the error `missing` (dotted
+    /// key, message) when none is.
+    fn exactly_one<T, const N: usize>(
+        &self,
+        options: [Option<T>; N],
+        several: (&str, &str),
+        missing: (&str, &str),
+    ) -> Result<T> {
+        self.at_most_one(options, several)?
+            .ok_or_else(|| self.err(missing.0, missing.1))
+    }
+
     /// `v` as a point of `dim` finite coordinates (the others 0).
     fn coords(&self, dim: usize, v: &[f64], key: &str) -> Result<[f64; 3]> {
         if v.len() != dim {
