@@ -1,7 +1,7 @@
 //! Line plots: several named series of (x, y) points as lines and/or markers.
 
 use super::{
-    draw_legend, extent, palette, plot_error, render, tick_label, titled_chart, DrawError, Figure,
+    axis_ticks, draw_legend, extent, palette, plot_error, render, titled_chart, DrawError, Figure,
     Labels, FONT,
 };
 use peritherm_core::error::Result;
@@ -172,10 +172,7 @@ impl Figure for LinePlot<'_> {
     {
         let (x, y) = (self.x, self.y);
         let mut chart = titled_chart(root, &self.labels.title, x, y)?;
-        let (xs, xl) = (x.1 - x.0, x.0.abs().max(x.1.abs()));
-        let (ys, yl) = (y.1 - y.0, y.0.abs().max(y.1.abs()));
-        let fx = |v: &f64| tick_label(*v, xs, xl);
-        let fy = |v: &f64| tick_label(*v, ys, yl);
+        let (fx, fy) = (axis_ticks(x), axis_ticks(y));
         chart
             .configure_mesh()
             .set_all_tick_mark_size(5)

@@ -221,6 +221,13 @@ fn tick_label(v: f64, span: f64, largest: f64) -> String {
     }
 }
 
+/// The tick labels of a linear axis over `(lo, hi)`: [`tick_label`] with the axis's span and
+/// largest magnitude.
+fn axis_ticks((lo, hi): (f64, f64)) -> impl Fn(&f64) -> String {
+    let (span, largest) = (hi - lo, lo.abs().max(hi.abs()));
+    move |v| tick_label(*v, span, largest)
+}
+
 /// `v` in short scientific notation: "2.5e-3", "1e6".
 fn sci(v: f64) -> String {
     let s = format!("{v:.2e}");
