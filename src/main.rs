@@ -232,13 +232,22 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             .build_global()
             .context("--threads")?;
     }
-    match cli.command {
+    dispatch(cli.command, &options, cli.threads)
+}
+
+/// Runs the subcommand `command` with the run options and the worker threads asked for.
+fn dispatch(
+    command: Command,
+    options: &peritherm::prepare::Options,
+    threads: Option<usize>,
+) -> anyhow::Result<()> {
+    match command {
         Command::Run {
             case,
             out,
             quiet,
             set,
-        } => run(&case, &set, &out, quiet, &options),
+        } => run(&case, &set, &out, quiet, options),
         Command::Fem {
             case,
             out,
@@ -246,15 +255,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             scheme,
             dt,
             quiet,
-        } => {
-            let opts = FemOptions {
-                h,
-                scheme,
-                dt,
-                mesh: None,
-            };
-            fem(&case, &out, &opts, quiet)
-        }
+        } => fem(&case, &out, &fem_options(h, scheme, dt), quiet),
         Command::Table {
             runs,
             json,
@@ -292,16 +293,26 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             json,
             command,
         } => {
-            let threads = cli.threads.unwrap_or_else(rayon::current_num_threads);
             let opts = peritherm::bench::BenchOptions {
                 quick,
                 nodes,
-                threads,
+                threads: threads.unwrap_or_else(rayon::current_num_threads),
                 cases,
             };
             bench(&opts, json.as_deref(), &command)
         }
-        Command::Check { case } => check(&case, &options),
+        Command::Check { case } => check(&case, options),
+    }
+}
+
+/// The settings of `peritherm fem`: the element size `h` (m) of a box case, the scheme and the
+/// step `dt` (s); a gmsh case's own mesh.
+fn fem_options(h: Option<f64>, scheme: Scheme, dt: Option<f64>) -> FemOptions {
+    FemOptions {
+        h,
+        scheme,
+        dt,
+        mesh: None,
     }
 }
 
@@ -484,7 +495,7 @@ fn bench(
 /// `peritherm check`: everything `run` does before its time loop (the budget, the model, the
 /// semantic checks, the step and its count, the steppers' set-up), and the sizes.
 fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyhow::Result<()> {
-    use peritherm::solve::explicit::Integrator;
+    use peritherm::solve::Integrator;
     let case = Case::load(path)?;
     say!("{}: {}", case.path.display(), case.budget.line());
     let model = peritherm::prepare::build(&case, options)?;

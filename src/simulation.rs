@@ -171,6 +171,14 @@ impl<'a> Simulation<'a> {
     }
 
     /// `n` steps of `h` from `t` (step s from t + s·h), the last ending at `end`.
+    ///
+    /// Not [`crate::solve::march`] (which [`Simulation::run`] reaches through
+    /// [`integrate`] for adaptive steps and the steady solve), though its step times are the
+    /// same: `march` divides each span between output times into equal steps
+    /// `(to − t)/n`, which may differ from [`Simulation::step`]'s exact `dt` in the last bit
+    /// and so change the fields; it cannot stop between steps when `keep_going` says so; and
+    /// it counts steps (the NaN check every 4096, the implicit stepper's `accepted` at
+    /// [`crate::solve::Stepper::finish`]) per call, where a simulation counts from its start.
     fn steps_of(
         &mut self,
         n: u64,

@@ -10,7 +10,7 @@ use peritherm::history::output_index;
 use peritherm::model::Model;
 use peritherm::output::RunSummary;
 use peritherm::simulation::{Simulation, Snapshot};
-use peritherm::solve::explicit::Integrator;
+use peritherm::solve::Integrator;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};

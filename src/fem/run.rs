@@ -81,7 +81,8 @@ pub fn run_fem(
     })
 }
 
-/// The time loop of the FEM solve, writing into the staged directory `out`.
+/// The FEM solve of the built `model` with its set-up timed from `t_setup`: the time loop
+/// ([`run_outputs`]) and run.json, written into the staged directory `out`.
 fn solve(
     case: &Case,
     model: &FemModel,
@@ -102,32 +103,15 @@ fn solve(
     };
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     let origin = crate::provenance::write_copy(out, case)?;
-    let mut reference = ReferenceCheck::of(case)?;
+    let reference = ReferenceCheck::of(case)?;
     let t_run = Instant::now();
-    let mut theta = model.theta0.clone();
-    let initial_energy = model.energy(&theta);
-    let mut flux = vec![Vector::zeros(); theta.len()];
-    let damage = vec![0.0; theta.len()];
-    let (mut energy, mut fields, mut t) = (Vec::new(), Vec::new(), 0.0);
-    for (k, &to) in case.outputs.iter().enumerate() {
-        clock.advance(&mut theta, t, to)?;
-        t = to;
-        energy.push(model.energy(&theta));
-        model.recovery.flux(&model.mesh, &theta, &mut flux);
-        let classical = reference
-            .as_mut()
-            .map(|r| r.compare(model, &theta, to))
-            .transpose()?;
-        let f = Fields {
-            theta: &theta,
-            damage: &damage,
-            flux: &flux,
-            reference: classical.as_deref(),
-        };
-        fields.push(write_field(out, k + 1, &model.cloud, &f)?);
-    }
-    let (comparisons, reference_seconds) =
-        reference.map_or((Vec::new(), 0.0), |r| (r.comparisons, r.seconds));
+    let initial_energy = model.energy(&model.theta0);
+    let Record {
+        energy,
+        fields,
+        comparisons,
+        reference_seconds,
+    } = run_outputs(&mut clock, model, out, reference)?;
     let summary = RunSummary {
         status: "complete".into(),
         title: case.title.clone(),
@@ -163,6 +147,57 @@ fn solve(
     };
     summary.write(out)?;
     Ok(summary)
+}
+
+/// What the output times of a FEM run recorded.
+struct Record {
+    /// Energy of the body at each output time, J.
+    energy: Vec<f64>,
+    /// The CSV field file of each output time.
+    fields: Vec<String>,
+    /// The comparisons with the reference at each output time (none without one).
+    comparisons: Vec<Comparison>,
+    /// Time spent evaluating and comparing the reference, s.
+    reference_seconds: f64,
+}
+
+/// Steps from the model's initial field at t = 0 through every output time of the case,
+/// writing each output's fields into `out` and comparing them with the `reference`, if any.
+fn run_outputs<P: FnMut(u64, u64)>(
+    clock: &mut Clock<'_, P>,
+    model: &FemModel,
+    out: &Path,
+    mut reference: Option<ReferenceCheck>,
+) -> Result<Record> {
+    let mut theta = model.theta0.clone();
+    let mut flux = vec![Vector::zeros(); theta.len()];
+    let damage = vec![0.0; theta.len()];
+    let (mut energy, mut fields, mut t) = (Vec::new(), Vec::new(), 0.0);
+    for (k, &to) in clock.case.outputs.iter().enumerate() {
+        clock.advance(&mut theta, t, to)?;
+        t = to;
+        energy.push(model.energy(&theta));
+        model.recovery.flux(&model.mesh, &theta, &mut flux);
+        let classical = reference
+            .as_mut()
+            .map(|r| r.compare(model, &theta, to))
+            .transpose()?;
+        let f = Fields {
+            theta: &theta,
+            damage: &damage,
+            flux: &flux,
+            reference: classical.as_deref(),
+        };
+        fields.push(write_field(out, k + 1, &model.cloud, &f)?);
+    }
+    let (comparisons, reference_seconds) =
+        reference.map_or((Vec::new(), 0.0), |r| (r.comparisons, r.seconds));
+    Ok(Record {
+        energy,
+        fields,
+        comparisons,
+        reference_seconds,
+    })
 }
 
 /// Writes `field_<k>.csv` and `field_<k>.vtu` of output `k` (from 1) into `out`; returns

@@ -249,16 +249,39 @@ fn terms(alpha: f64, t: f64, c: f64) -> usize {
     (n.ceil() as usize + 2).clamp(200, 200_000)
 }
 
+/// The modes n = 1, 2, … of a series with λ_n = c n, as many as [`terms`] asks: (n, λ_n), λ in
+/// the unit of c.
+fn modes(alpha: f64, t: f64, c: f64) -> impl Iterator<Item = (usize, f64)> {
+    (1..=terms(alpha, t, c)).map(move |n| (n, c * n as f64))
+}
+
+/// The modes n = 1, 2, … of a series with λ_n = c (2n − 1), as many as [`terms`] asks for
+/// the spacing 2c: (n, λ_n), λ in the unit of c.
+fn odd_modes(alpha: f64, t: f64, c: f64) -> impl Iterator<Item = (usize, f64)> {
+    (1..=terms(alpha, t, 2.0 * c)).map(move |n| (n, c * (2 * n - 1) as f64))
+}
+
+/// `start + Σ term(n, λ_n) e^(−α λ_n² t)` over the `modes` (n, λ_n), summed in their order:
+/// the decaying modes of a separation-of-variables series (α in m²/s, t in s, λ in 1/m).
+fn decaying(
+    start: f64,
+    alpha: f64,
+    t: f64,
+    modes: impl Iterator<Item = (usize, f64)>,
+    term: impl Fn(usize, f64) -> f64,
+) -> f64 {
+    modes.fold(start, |sum, (n, lam)| {
+        sum + term(n, lam) * (-alpha * lam * lam * t).exp()
+    })
+}
+
 /// (4/π) Σ_{m odd} sin(mπs/L)/m e^(−α m²π² t/L²): the unit solution of a slab held at 0.
 fn slab(s: f64, l: f64, alpha: f64, t: f64) -> f64 {
     let c = PI / l;
-    let n = terms(alpha, t, c);
-    let mut sum = 0.0;
-    for m in (1..=n).step_by(2) {
-        let lam = c * m as f64;
-        sum += (lam * s).sin() / m as f64 * (-alpha * lam * lam * t).exp();
-    }
-    4.0 / PI * sum
+    let odd = (1..=terms(alpha, t, c))
+        .step_by(2)
+        .map(|m| (m, c * m as f64));
+    4.0 / PI * decaying(0.0, alpha, t, odd, |m, lam| (lam * s).sin() / m as f64)
 }
 
 /// The unit solution of one axis of a [`Reference::BoxFixedFaces`] at s ∈ [0, L] (1 inside
@@ -517,14 +540,11 @@ impl Reference {
             return f64::NAN;
         };
         let (s, c) = ((y - y0).clamp(0.0, w), split - y0);
-        let mut sum = (below * c + above * (w - c)) / w;
-        let k = PI / w;
-        for n in 1..=terms(a, t, k) {
-            let lam = k * n as f64;
+        let mean = (below * c + above * (w - c)) / w;
+        decaying(mean, a, t, modes(a, t, PI / w), |n, lam| {
             let b = 2.0 * (below - above) * (lam * c).sin() / (n as f64 * PI);
-            sum += b * (lam * s).cos() * (-a * lam * lam * t).exp();
-        }
-        sum
+            b * (lam * s).cos()
+        })
     }
 
     /// The classical temperature at the point (x, y, z), m, and time t, s, °C.
@@ -626,10 +646,7 @@ impl Reference {
             return f64::NAN;
         };
         let r = x.hypot(y).hypot(z).min(rs);
-        let c = PI / rs;
-        let mut sum = 0.0;
-        for n in 1..=terms(a, t, c) {
-            let lam = c * n as f64;
+        let sum = decaying(0.0, a, t, modes(a, t, PI / rs), |n, lam| {
             let sign = if n % 2 == 1 { 1.0 } else { -1.0 };
             // sin(λr)/(λr) → 1 at the centre
             let sinc = if lam * r < 1e-8 {
@@ -637,8 +654,8 @@ impl Reference {
             } else {
                 (lam * r).sin() / (lam * r)
             };
-            sum += 2.0 * sign * sinc * (-a * lam * lam * t).exp();
-        }
+            2.0 * sign * sinc
+        });
         surface + (initial - surface) * sum
     }
 
@@ -685,15 +702,12 @@ impl Reference {
             return f64::NAN;
         };
         let s = x - x0;
-        let c = PI / l;
-        let mut sum = left + (right - left) * s / l;
-        for n in 1..=terms(a, t, c) {
+        let steady = left + (right - left) * s / l;
+        decaying(steady, a, t, modes(a, t, PI / l), |n, lam| {
             let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
             let b = 2.0 / (n as f64 * PI) * (initial * (1.0 - sign) - left + right * sign);
-            let lam = c * n as f64;
-            sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
-        }
-        sum
+            b * (lam * s).sin()
+        })
     }
 
     /// A [`Reference::BarInsulatedLeft`] at x, t: the odd cosine modes from the two-step
@@ -711,16 +725,13 @@ impl Reference {
             return f64::NAN;
         };
         let s = x - x0;
-        let mut sum = right;
-        let c = PI / (2.0 * l);
-        for n in 1..=terms(a, t, 2.0 * c) {
-            let lam = c * (2 * n - 1) as f64;
+        let odd = odd_modes(a, t, PI / (2.0 * l));
+        decaying(right, a, t, odd, |_, lam| {
             let cn = 2.0 / (l * lam)
                 * ((initial_left - right) * (lam * l / 2.0).sin()
                     + (initial_right - right) * ((lam * l).sin() - (lam * l / 2.0).sin()));
-            sum += cn * (lam * s).cos() * (-a * lam * lam * t).exp();
-        }
-        sum
+            cn * (lam * s).cos()
+        })
     }
 
     /// A [`Reference::BarFixedFlux`] at x, t: the linear steady state plus the odd sine modes
@@ -738,15 +749,12 @@ impl Reference {
             return f64::NAN;
         };
         let s = x - x0;
-        let mut sum = left + g * s;
-        let c = PI / (2.0 * l);
-        for n in 1..=terms(a, t, 2.0 * c) {
-            let lam = c * (2 * n - 1) as f64;
+        let odd = odd_modes(a, t, PI / (2.0 * l));
+        decaying(left + g * s, a, t, odd, |n, lam| {
             let alt = if n % 2 == 1 { 1.0 } else { -1.0 };
             let b = 2.0 / l * ((initial - left) / lam - g * alt / (lam * lam));
-            sum += b * (lam * s).sin() * (-a * lam * lam * t).exp();
-        }
-        sum
+            b * (lam * s).sin()
+        })
     }
 }
 
@@ -755,15 +763,13 @@ impl Reference {
 fn pulse_left(s: f64, l: f64, a: f64, amp: f64, r: f64, t: f64) -> f64 {
     let g = amp * t * (-r * t).exp();
     let c = PI / (2.0 * l);
-    let mut sum = g;
     let nmax = terms(a, t, 2.0 * c).max(4000);
-    for n in 1..=nmax {
-        let lam = c * (2 * n - 1) as f64;
-        let mu = a * lam * lam;
-        let an = 2.0 / (l * lam);
-        sum -= an * duhamel(amp, r, mu, t) * (lam * s).sin();
-    }
-    sum
+    (1..=nmax)
+        .map(|n| c * (2 * n - 1) as f64)
+        .fold(g, |sum, lam| {
+            let an = 2.0 / (l * lam);
+            sum - an * duhamel(amp, r, a * lam * lam, t) * (lam * s).sin()
+        })
 }
 
 /// The parameters of a [`Reference::FilmLaserPulse`] (units there).

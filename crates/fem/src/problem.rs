@@ -249,7 +249,7 @@ impl FemModel {
 
 /// Number of equal steps no longer than `dt` that cover `span`, s.
 pub fn steps_for(span: f64, dt: f64) -> u64 {
-    peritherm_core::solve::explicit::steps_between(0.0, span, dt).max(1)
+    peritherm_core::solve::steps_between(0.0, span, dt).max(1)
 }
 
 /// Refuses, before anything is allocated, a structured box mesh beyond the memory and a step

@@ -253,20 +253,34 @@ pub fn accuracy(
     provenance: Provenance,
     runs: &[(&Path, &RunSummary)],
 ) -> Figures {
+    let columns = RunSummary::TABLE_COLUMNS;
+    of_runs(name, command, &columns, provenance, runs, |dir, run| {
+        (run.table_cells(), run_checks(dir, run))
+    })
+}
+
+/// A figure table of finished runs under the headings `columns`: `each(dir, run)` gives the
+/// rows and checks of one run (its run.json with its output directory).
+fn of_runs(
+    name: &str,
+    command: &str,
+    columns: &[&str],
+    provenance: Provenance,
+    runs: &[(&Path, &RunSummary)],
+    mut each: impl FnMut(&Path, &RunSummary) -> (Vec<Vec<String>>, Vec<Check>),
+) -> Figures {
     let mut rows = Vec::new();
     let mut checks = Vec::new();
     for (dir, run) in runs {
-        rows.extend(run.table_cells());
-        checks.extend(run_checks(dir, run));
+        let (r, c) = each(dir, run);
+        rows.extend(r);
+        checks.extend(c);
     }
     Figures {
         name: name.into(),
         command: command.into(),
         provenance,
-        columns: RunSummary::TABLE_COLUMNS
-            .iter()
-            .map(|c| c.to_string())
-            .collect(),
+        columns: columns.iter().map(|c| c.to_string()).collect(),
         rows,
         checks,
     }
@@ -351,40 +365,6 @@ pub fn fields(
     provenance: Provenance,
     runs: &[(&Path, &RunSummary)],
 ) -> Figures {
-    let mut rows = Vec::new();
-    let mut checks = Vec::new();
-    for (dir, run) in runs {
-        let exact = is_exact(run);
-        let files = field_checks(dir, run);
-        for (k, (t, energy)) in run.output_times.iter().zip(&run.energy).enumerate() {
-            let hash = files.get(k).map_or("-".into(), |(h, _)| h.clone());
-            rows.push(vec![
-                format!("`{}`", run.case),
-                run.settings.join(" "),
-                run.integrator.clone(),
-                run.nodes.to_string(),
-                run.steps.to_string(),
-                format!("{t:e}"),
-                format!("{energy:.9e}"),
-                if exact { hash } else { format!("({hash})") },
-            ]);
-            // an energy that cancels to round-off (a body held at +θ and −θ) is no digest of
-            // an implicit run's field: only explicit runs, whose files are compared, keep it
-            if !exact && energy.abs() < ENERGY_FLOOR {
-                continue;
-            }
-            checks.push(Check::Measure {
-                args: run_args(run),
-                file: "run.json".into(),
-                pointer: format!("/energy/{k}"),
-                value: *energy,
-                rel_tol: if exact { REL_TOL_EXACT } else { ENERGY_REL_TOL },
-            });
-        }
-        if exact {
-            checks.extend(files.into_iter().map(|(_, c)| c));
-        }
-    }
     let columns = [
         "case",
         "set",
@@ -395,14 +375,44 @@ pub fn fields(
         "energy (J)",
         "field (FNV-1a)",
     ];
-    Figures {
-        name: name.into(),
-        command: command.into(),
-        provenance,
-        columns: columns.iter().map(|c| c.to_string()).collect(),
-        rows,
-        checks,
+    of_runs(name, command, &columns, provenance, runs, field_rows)
+}
+
+/// The rows of one run in the fields table (one per output time) and its checks.
+fn field_rows(dir: &Path, run: &RunSummary) -> (Vec<Vec<String>>, Vec<Check>) {
+    let mut rows = Vec::new();
+    let mut checks = Vec::new();
+    let exact = is_exact(run);
+    let files = field_checks(dir, run);
+    for (k, (t, energy)) in run.output_times.iter().zip(&run.energy).enumerate() {
+        let hash = files.get(k).map_or("-".into(), |(h, _)| h.clone());
+        rows.push(vec![
+            format!("`{}`", run.case),
+            run.settings.join(" "),
+            run.integrator.clone(),
+            run.nodes.to_string(),
+            run.steps.to_string(),
+            format!("{t:e}"),
+            format!("{energy:.9e}"),
+            if exact { hash } else { format!("({hash})") },
+        ]);
+        // an energy that cancels to round-off (a body held at +θ and −θ) is no digest of
+        // an implicit run's field: only explicit runs, whose files are compared, keep it
+        if !exact && energy.abs() < ENERGY_FLOOR {
+            continue;
+        }
+        checks.push(Check::Measure {
+            args: run_args(run),
+            file: "run.json".into(),
+            pointer: format!("/energy/{k}"),
+            value: *energy,
+            rel_tol: if exact { REL_TOL_EXACT } else { ENERGY_REL_TOL },
+        });
     }
+    if exact {
+        checks.extend(files.into_iter().map(|(_, c)| c));
+    }
+    (rows, checks)
 }
 
 impl Provenance {

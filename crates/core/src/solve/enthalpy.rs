@@ -13,7 +13,7 @@ use crate::material::Enthalpy;
 use crate::model::Model;
 use crate::operator::Conductance;
 use crate::solve::integrator::Integrator;
-use crate::solve::stepper::{check_finite, march, RunStats, Stepper};
+use crate::solve::stepper::{march, RunStats, Stepper};
 use rayon::prelude::*;
 
 /// Enthalpy-form explicit integrator state with preallocated buffers.
@@ -246,8 +246,8 @@ impl<'a> Enthalpic<'a> {
 }
 
 impl Stepper for Enthalpic<'_> {
-    fn n_body(&self) -> usize {
-        self.model.cloud.n_body
+    fn model(&self) -> &Model {
+        self.model
     }
     fn begin(&mut self, theta: &mut [f64], t: f64) {
         self.start(theta, t);
@@ -255,9 +255,6 @@ impl Stepper for Enthalpic<'_> {
     fn advance(&mut self, theta: &mut [f64], t: f64, _t1: f64, h: f64) -> Result<()> {
         self.step(theta, t, h);
         Ok(())
-    }
-    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
-        check_finite(theta, self.model.cloud.n_body, t)
     }
     fn conductance_now(&mut self) -> &Conductance {
         self.scale_conductance();

@@ -336,8 +336,8 @@ impl<'a> Explicit<'a> {
 }
 
 impl Stepper for Explicit<'_> {
-    fn n_body(&self) -> usize {
-        self.model.cloud.n_body
+    fn model(&self) -> &Model {
+        self.model
     }
     fn begin(&mut self, _theta: &mut [f64], t: f64) {
         self.cut_until(t);
@@ -375,9 +375,6 @@ impl Stepper for Explicit<'_> {
     }
     fn conductance_now(&mut self) -> &Conductance {
         &self.conductance
-    }
-    fn energy_now(&self, theta: &[f64]) -> f64 {
-        self.model.energy(theta)
     }
 }
 

@@ -23,8 +23,13 @@ pub struct RunStats {
 /// The explicit steppers keep θ current; the implicit one keeps its state in the unknowns and
 /// writes it into θ at [`Stepper::settle`].
 pub trait Stepper {
+    /// The model the stepper integrates.
+    fn model(&self) -> &Model;
+
     /// Number of body nodes (the entries of θ that are checked for NaN).
-    fn n_body(&self) -> usize;
+    fn n_body(&self) -> usize {
+        self.model().cloud.n_body
+    }
 
     /// Refuses a fixed step `dt` (s) the stepper cannot take (implicit: not positive and
     /// finite); the explicit steppers take any step the plan chose.
@@ -54,16 +59,23 @@ pub trait Stepper {
     }
 
     /// Brings θ up to time `t` (s) after steps (implicit: the state into θ, constrained nodes
-    /// set; growing cracks: K cut) and fails if a body temperature is not finite.
-    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()>;
+    /// set; growing cracks: K cut) and fails if a body temperature is not finite; by default
+    /// only the check, θ being current.
+    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        check_finite(theta, self.n_body(), t)
+    }
 
     /// K as it is after [`Stepper::settle`] (growing cracks cut; with phase change, the
-    /// current conductivities), W/K.
-    fn conductance_now(&mut self) -> &Conductance;
+    /// current conductivities), W/K; by default the model's.
+    fn conductance_now(&mut self) -> &Conductance {
+        &self.model().conductance
+    }
 
-    /// Energy of the body in the state `theta`, J: Σ V_i ρc_i θ_i, or with phase change
-    /// Σ V_i H_i of the stepper once it has begun.
-    fn energy_now(&self, theta: &[f64]) -> f64;
+    /// Energy of the body in the state `theta`, J: Σ V_i ρc_i θ_i ([`Model::energy`], the
+    /// default), or with phase change Σ V_i H_i of the stepper once it has begun.
+    fn energy_now(&self, theta: &[f64]) -> f64 {
+        self.model().energy(theta)
+    }
 
     /// Called by [`march`] at the end of a run with its counters.
     fn finish(&mut self, stats: &RunStats) {

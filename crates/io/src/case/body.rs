@@ -198,22 +198,22 @@ impl CaseFile {
         if !(1..=3).contains(&dim) {
             return Err(cx.err("dimension", format!("must be 1, 2 or 3, got {dim}")));
         }
-        let (section, thickness, area) = match (&self.domain, &self.mesh) {
-            (Some(d), None) => ("domain", d.thickness, d.area),
-            (None, Some(m)) => ("mesh", m.thickness, m.area),
-            (Some(_), Some(_)) => {
-                return Err(cx.err(
-                    "mesh",
-                    "give [domain] (a built-in box) or [mesh] (a gmsh file), not both",
-                ))
-            }
-            (None, None) => {
-                return Err(cx.err(
-                    "domain",
-                    "missing: give [domain] with box regions, or [mesh] with a gmsh file",
-                ))
-            }
-        };
+        let (section, thickness, area) = cx.exactly_one(
+            [
+                self.domain
+                    .as_ref()
+                    .map(|d| ("domain", d.thickness, d.area)),
+                self.mesh.as_ref().map(|m| ("mesh", m.thickness, m.area)),
+            ],
+            (
+                "mesh",
+                "give [domain] (a built-in box) or [mesh] (a gmsh file), not both",
+            ),
+            (
+                "domain",
+                "missing: give [domain] with box regions, or [mesh] with a gmsh file",
+            ),
+        )?;
         self.check_symmetry(cx, section, thickness.is_some() || area.is_some())?;
         let tau = match dim {
             1 if thickness.is_some() => Err(cx.err(
@@ -354,6 +354,14 @@ impl CaseFile {
     }
 }
 
+/// How a box region is divided: `spacing` or `cells`, the one given.
+enum Resolution<'a> {
+    /// Node spacing Δ, m.
+    Spacing(f64),
+    /// Cells per axis.
+    Cells(&'a [usize]),
+}
+
 /// `[[region]]` number `r` of a box case: its corners within the domain `(min, max)` and its
 /// cells, from `spacing` or `cells`.
 fn box_region(
@@ -377,13 +385,17 @@ fn box_region(
         return Err(cx.err(key("max"), "must exceed min on every axis"));
     }
     let mut cells = [1usize; 3];
-    match (&reg.spacing, &reg.cells) {
-        (Some(_), Some(_)) => {
-            return Err(cx.err(key("spacing"), "give spacing or cells, not both"));
-        }
-        (None, None) => return Err(cx.err(key("spacing"), "missing: give spacing or cells")),
-        (Some(h), None) => {
-            let h = cx.positive(&key("spacing"), *h)?;
+    let resolution = cx.exactly_one(
+        [
+            reg.spacing.map(Resolution::Spacing),
+            reg.cells.as_deref().map(Resolution::Cells),
+        ],
+        (&key("spacing"), "give spacing or cells, not both"),
+        (&key("spacing"), "missing: give spacing or cells"),
+    )?;
+    match resolution {
+        Resolution::Spacing(h) => {
+            let h = cx.positive(&key("spacing"), h)?;
             for a in 0..dim {
                 let n = (rmax[a] - rmin[a]) / h;
                 let nr = n.round();
@@ -399,7 +411,7 @@ fn box_region(
                 cells[a] = nr as usize;
             }
         }
-        (None, Some(c)) => {
+        Resolution::Cells(c) => {
             if c.len() != dim || c.contains(&0) {
                 return Err(cx.err(key("cells"), format!("needs {dim} positive counts")));
             }

@@ -74,15 +74,28 @@ pub(super) fn cracks(
                 format!("must be in [0, 1), got {mu}"),
             ));
         }
-        let shape = match (&spec.group, &spec.points) {
-            (Some(g), None) => CrackShape::Set(group(at, g, set_names, faces)?),
-            (None, Some(pts)) => shape(at, pts)?,
-            _ => return Err(cx.err(format!("crack[{c}]"), "give either group or points")),
+        let key = format!("crack[{c}]");
+        let either = (key.as_str(), "give either group or points");
+        let along = [
+            spec.group.as_deref().map(Along::Group),
+            spec.points.as_deref().map(Along::Points),
+        ];
+        let shape = match cx.exactly_one(along, either, either)? {
+            Along::Group(g) => CrackShape::Set(group(at, g, set_names, faces)?),
+            Along::Points(pts) => shape(at, pts)?,
         };
         let growth = growth(at, spec, &shape)?;
         out.push(Crack { shape, mu, growth });
     }
     Ok(out)
+}
+
+/// What a crack follows: `group` or `points`, the one given.
+enum Along<'a> {
+    /// A mesh physical group.
+    Group(&'a str),
+    /// A polyline (2D) or planar polygon (3D), m.
+    Points(&'a [Vec<f64>]),
 }
 
 /// The boundary set of a crack along the mesh group `g`: a non-empty group with no condition.

@@ -4,7 +4,7 @@ use super::Ctx;
 use crate::history::{HistoryPlot, HistorySpec};
 use peritherm_core::error::Result;
 use peritherm_core::limits::{MAX_HISTORY_POINTS, MAX_HISTORY_ROWS};
-use peritherm_core::solve::explicit::Integrator;
+use peritherm_core::solve::Integrator;
 use serde::Deserialize;
 
 /// `[history]` as written: points sampled at a regular interval up to the last output.

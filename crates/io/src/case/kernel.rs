@@ -91,12 +91,17 @@ impl KernelSpec {
                 ),
             ));
         }
-        if self.linear_consistency && self.consistency.is_some() {
-            return Err(cx.err(
+        let keys = [
+            self.linear_consistency.then_some(()),
+            self.consistency.map(|_| ()),
+        ];
+        cx.at_most_one(
+            keys,
+            (
                 "kernel.linear_consistency",
                 "give either linear_consistency or consistency, not both",
-            ));
-        }
+            ),
+        )?;
         Ok(())
     }
 

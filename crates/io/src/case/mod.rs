@@ -30,7 +30,7 @@ use peritherm_core::expr::Expr;
 use peritherm_core::material::Material;
 use peritherm_core::math::Point;
 use peritherm_core::model::{Geometry, ModelSpec};
-use peritherm_core::solve::explicit::Integrator;
+use peritherm_core::solve::Integrator;
 use peritherm_core::symmetry::Symmetry;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -304,6 +304,34 @@ impl<'a> Ctx<'a> {
         } else {
             Err(self.err(key, format!("must be a positive number, got {v}")))
         }
+    }
+
+    /// The value of the one key given among `options` (each key's value, None where it is
+    /// absent), of keys of which at most one may be given: None when none is, and the error
+    /// `several` (dotted key, message) when more than one is.
+    fn at_most_one<T, const N: usize>(
+        &self,
+        options: [Option<T>; N],
+        several: (&str, &str),
+    ) -> Result<Option<T>> {
+        let mut given = options.into_iter().flatten();
+        let one = given.next();
+        match given.next() {
+            Some(_) => Err(self.err(several.0, several.1)),
+            None => Ok(one),
+        }
+    }
+
+    /// [`Ctx::at_most_one`] of keys one of which must be given: the error `missing` (dotted
+    /// key, message) when none is.
+    fn exactly_one<T, const N: usize>(
+        &self,
+        options: [Option<T>; N],
+        several: (&str, &str),
+        missing: (&str, &str),
+    ) -> Result<T> {
+        self.at_most_one(options, several)?
+            .ok_or_else(|| self.err(missing.0, missing.1))
     }
 
     /// `v` as a point of `dim` finite coordinates (the others 0).

@@ -9,7 +9,7 @@ use peritherm_core::limits::MAX_HISTORY_POINTS;
 use peritherm_core::math::Point;
 use peritherm_fem::{FemOptions, Scheme};
 use serde::Deserialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// `[reference]` as written: one classical solution and where to compare.
@@ -150,12 +150,21 @@ impl ReferenceSection {
 
     /// The one source given: `solution`, `file` or `fem`.
     fn source(&self, cx: Ctx, dim: usize, outputs: &[f64]) -> Result<ReferenceSource> {
-        match (&self.solution, &self.file, &self.fem) {
-            (Some(s), None, None) => match s.check() {
+        let one = (
+            "reference",
+            "give exactly one of `solution` (analytical), `file` (a CSV table) or `fem` (the built-in FEM solve)",
+        );
+        let given = [
+            self.solution.as_ref().map(Given::Solution),
+            self.file.as_deref().map(Given::File),
+            self.fem.as_ref().map(Given::Fem),
+        ];
+        match cx.exactly_one(given, one, one)? {
+            Given::Solution(s) => match s.check() {
                 Some(m) => Err(cx.err("reference.solution", m)),
                 None => Ok(ReferenceSource::Analytic(s.clone())),
             },
-            (None, None, Some(f)) => {
+            Given::Fem(f) => {
                 for (key, v) in [("reference.fem.h", f.h), ("reference.fem.dt", f.dt)] {
                     if let Some(v) = v {
                         cx.positive(key, v)?;
@@ -168,17 +177,23 @@ impl ReferenceSection {
                     mesh: f.mesh.as_ref().map(|m| cx.beside(m)),
                 }))
             }
-            (None, Some(file), None) => {
+            Given::File(file) => {
                 let table = ReferenceTable::read(&cx.beside(file), dim)?;
                 table
                     .check_times(outputs)
                     .map_err(|m| cx.err("reference.file", m))?;
                 Ok(ReferenceSource::Table(Arc::new(table)))
             }
-            _ => Err(cx.err(
-                "reference",
-                "give exactly one of `solution` (analytical), `file` (a CSV table) or `fem` (the built-in FEM solve)",
-            )),
         }
     }
+}
+
+/// The source `[reference]` gives: `solution`, `file` or `fem`, the one given.
+enum Given<'a> {
+    /// An analytical solution.
+    Solution(&'a Reference),
+    /// A CSV table, its path as the case file writes it.
+    File(&'a Path),
+    /// The built-in FEM solve.
+    Fem(&'a FemReferenceSpec),
 }

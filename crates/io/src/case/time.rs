@@ -5,7 +5,7 @@ use peritherm_core::error::Result;
 use peritherm_core::expr::Expr;
 use peritherm_core::material::Material;
 use peritherm_core::model::Initial;
-use peritherm_core::solve::explicit::Integrator;
+use peritherm_core::solve::Integrator;
 use serde::Deserialize;
 
 /// `[initial]`.

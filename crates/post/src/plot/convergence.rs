@@ -3,7 +3,8 @@
 use super::line::check_series;
 use super::FONT;
 use super::{
-    extent, palette, plot_error, render, sci, Chart, DrawError, Figure, Labels, Legend, Series,
+    draw_legend, extent, palette, plot_error, render, sci, titled_chart, Chart, DrawError, Figure,
+    Labels, Legend, Series,
 };
 use peritherm_core::error::{Error, Result};
 use plotters::coord::Shift;
@@ -176,12 +177,7 @@ impl Figure for Convergence<'_> {
     {
         let (x0, y0) = lg((self.x.0, self.y.0));
         let (x1, y1) = lg((self.x.1, self.y.1));
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.labels.title, (FONT, 26))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
+        let mut chart = titled_chart(root, &self.labels.title, (x0, x1), (y0, y1))?;
         chart
             .configure_mesh()
             .disable_mesh()
@@ -193,16 +189,7 @@ impl Figure for Convergence<'_> {
             .draw()?;
         draw_log_grid(&mut chart, root, (x0, x1), (y0, y1))?;
         self.draw_series(&mut chart)?;
-        if let Some(pos) = self.legend.position() {
-            chart
-                .configure_series_labels()
-                .position(pos)
-                .label_font((FONT, 18))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .draw()?;
-        }
-        Ok(())
+        draw_legend(&mut chart, self.legend)
     }
 }
 

@@ -1,6 +1,9 @@
 //! Line plots: several named series of (x, y) points as lines and/or markers.
 
-use super::{extent, palette, plot_error, render, tick_label, DrawError, Figure, Labels, FONT};
+use super::{
+    axis_ticks, draw_legend, extent, palette, plot_error, render, titled_chart, DrawError, Figure,
+    Labels, FONT,
+};
 use peritherm_core::error::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -168,16 +171,8 @@ impl Figure for LinePlot<'_> {
         DB::ErrorType: 'static,
     {
         let (x, y) = (self.x, self.y);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.labels.title, (FONT, 26))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(x.0..x.1, y.0..y.1)?;
-        let (xs, xl) = (x.1 - x.0, x.0.abs().max(x.1.abs()));
-        let (ys, yl) = (y.1 - y.0, y.0.abs().max(y.1.abs()));
-        let fx = |v: &f64| tick_label(*v, xs, xl);
-        let fy = |v: &f64| tick_label(*v, ys, yl);
+        let mut chart = titled_chart(root, &self.labels.title, x, y)?;
+        let (fx, fy) = (axis_ticks(x), axis_ticks(y));
         chart
             .configure_mesh()
             .set_all_tick_mark_size(5)
@@ -227,14 +222,8 @@ impl Figure for LinePlot<'_> {
                 }),
             };
         }
-        if let (true, Some(pos)) = (named, self.legend.position()) {
-            chart
-                .configure_series_labels()
-                .position(pos)
-                .label_font((FONT, 18))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .draw()?;
+        if named {
+            draw_legend(&mut chart, self.legend)?;
         }
         Ok(())
     }

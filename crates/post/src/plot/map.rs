@@ -2,7 +2,7 @@
 //! colour bar, axes, optional region outlines, crack segments and heat-flux arrows.
 
 use super::{
-    extent, plot_error, render, tick_label, widen, Chart, ColourMap, DrawError, Figure, FONT,
+    axis_ticks, extent, plot_error, render, widen, Chart, ColourMap, DrawError, Figure, FONT,
 };
 use peritherm_core::error::Result;
 use peritherm_core::math::{Point, Vector};
@@ -485,8 +485,7 @@ impl MapFigure<'_> {
             [(0.0, lo), (1.0, hi)],
             BLACK.stroke_width(1),
         )))?;
-        let (bs, bl) = (hi - lo, lo.abs().max(hi.abs()));
-        let fb = |v: &f64| tick_label(*v, bs, bl);
+        let fb = axis_ticks((lo, hi));
         cb.configure_mesh()
             .set_all_tick_mark_size(5)
             .disable_x_axis()
@@ -556,10 +555,7 @@ fn draw_axes<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let (xs, xl) = (xr.1 - xr.0, xr.0.abs().max(xr.1.abs()));
-    let (ys, yl) = (yr.1 - yr.0, yr.0.abs().max(yr.1.abs()));
-    let fx = |v: &f64| tick_label(*v, xs, xl);
-    let fy = |v: &f64| tick_label(*v, ys, yl);
+    let (fx, fy) = (axis_ticks(xr), axis_ticks(yr));
     chart
         .configure_mesh()
         .set_all_tick_mark_size(5)

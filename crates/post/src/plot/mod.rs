@@ -97,6 +97,47 @@ trait Figure {
         DB::ErrorType: 'static;
 }
 
+/// The chart of the line and convergence plots on `root`: `title` above, room for the axis
+/// labels, f64 axes over the ranges `x` and `y` (their mesh is the caller's).
+fn titled_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> std::result::Result<Chart<'a, DB>, DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    let chart = ChartBuilder::on(root)
+        .caption(title, (FONT, 26))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)?;
+    Ok(chart)
+}
+
+/// The box of the series' legend entries in the corner `legend` asks for (none for
+/// [`Legend::None`]).
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    legend: Legend,
+) -> std::result::Result<(), DrawError>
+where
+    DB::ErrorType: 'static,
+{
+    if let Some(pos) = legend.position() {
+        chart
+            .configure_series_labels()
+            .position(pos)
+            .label_font((FONT, 18))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .draw()?;
+    }
+    Ok(())
+}
+
 /// `stem` with `.ext` appended (a stem like `conv_k0.5` keeps its dot).
 fn with_ext(stem: &Path, ext: &str) -> PathBuf {
     let mut s = stem.as_os_str().to_owned();
@@ -178,6 +219,13 @@ fn tick_label(v: f64, span: f64, largest: f64) -> String {
     } else {
         s.into()
     }
+}
+
+/// The tick labels of a linear axis over `(lo, hi)`: [`tick_label`] with the axis's span and
+/// largest magnitude.
+fn axis_ticks((lo, hi): (f64, f64)) -> impl Fn(&f64) -> String {
+    let (span, largest) = (hi - lo, lo.abs().max(hi.abs()));
+    move |v| tick_label(*v, span, largest)
 }
 
 /// `v` in short scientific notation: "2.5e-3", "1e6".

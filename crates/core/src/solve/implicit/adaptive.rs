@@ -430,14 +430,7 @@ impl Implicit<'_> {
             v.resize(n, 0.0);
         }
         let par = self.options.parallel;
-        self.gather(theta);
-        self.sys.forcing(
-            self.model,
-            t0,
-            &mut self.scratch,
-            &mut self.rate,
-            &mut self.f_now,
-        );
+        self.take_state(theta, t0);
         Self::derivative(&self.sys, &self.u, &self.f_now, &mut self.d_now, par);
         match first {
             Some(h) if h.is_finite() && h > 0.0 => Ok(h),

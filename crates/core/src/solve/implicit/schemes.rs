@@ -4,8 +4,9 @@
 use super::linear::Guess;
 use super::Implicit;
 use crate::error::{Error, Result};
+use crate::model::Model;
 use crate::operator::Conductance;
-use crate::solve::stepper::{march, RunStats, Stepper};
+use crate::solve::stepper::{check_finite, march, RunStats, Stepper};
 
 /// Implicit time-stepping scheme (theory §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -74,10 +75,19 @@ impl Implicit<'_> {
         Ok(())
     }
 
-    pub(super) fn gather(&mut self, theta: &[f64]) {
+    /// Takes the unknowns from `theta` (every node, °C) and the forcing f at `t` (s) into
+    /// `f_now`: where fixed steps ([`Implicit::start`]) and adaptive ones start.
+    pub(super) fn take_state(&mut self, theta: &[f64], t: f64) {
         for (u, &i) in self.u.iter_mut().zip(&self.sys.free) {
             *u = theta[i];
         }
+        self.sys.forcing(
+            self.model,
+            t,
+            &mut self.scratch,
+            &mut self.rate,
+            &mut self.f_now,
+        );
     }
 
     /// Writes the unknowns into `theta` and sets every constrained node at time t.
@@ -86,27 +96,14 @@ impl Implicit<'_> {
             theta[i] = u;
         }
         self.model.boundary.apply(&self.model.cloud, theta, t);
-        match theta[..self.model.cloud.n_body]
-            .iter()
-            .position(|v| !v.is_finite())
-        {
-            Some(node) => Err(Error::NonFinite { node, time: t }),
-            None => Ok(()),
-        }
+        check_finite(theta, self.model.cloud.n_body, t)
     }
 
     /// Starts fixed-step stepping ([`Implicit::step`]) from `theta` (every node, °C) at
     /// `t0`, s: the unknowns and the forcing are taken there, and the next step is a start-up
     /// step (Crank–Nicolson: two backward-Euler half steps; BDF2: backward Euler).
     pub fn start(&mut self, theta: &[f64], t0: f64) {
-        self.gather(theta);
-        self.sys.forcing(
-            self.model,
-            t0,
-            &mut self.scratch,
-            &mut self.rate,
-            &mut self.f_now,
-        );
+        self.take_state(theta, t0);
         self.taken = 0;
         self.h_prev = 0.0;
     }
@@ -171,8 +168,8 @@ impl Implicit<'_> {
 }
 
 impl Stepper for Implicit<'_> {
-    fn n_body(&self) -> usize {
-        self.model.cloud.n_body
+    fn model(&self) -> &Model {
+        self.model
     }
     fn check_dt(&self, dt: f64) -> Result<()> {
         if !(dt.is_finite() && dt > 0.0) {
@@ -197,12 +194,6 @@ impl Stepper for Implicit<'_> {
     }
     fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
         self.scatter(theta, t)
-    }
-    fn conductance_now(&mut self) -> &Conductance {
-        &self.model.conductance
-    }
-    fn energy_now(&self, theta: &[f64]) -> f64 {
-        self.model.energy(theta)
     }
     fn finish(&mut self, stats: &RunStats) {
         self.stats.accepted = stats.steps;
