@@ -342,6 +342,19 @@ fn run(
     if let Some(env) = peritherm::distributed::Environment::init() {
         return run_mpi(&env, path, set, out, quiet, options);
     }
+    #[cfg(not(feature = "mpi"))]
+    if let Some(n) = launched_ranks().filter(|&n| n > 1) {
+        // N copies would each run the whole case into the same directory; the first says so
+        let rank = ["PMI_RANK", "OMPI_COMM_WORLD_RANK", "SLURM_PROCID"]
+            .iter()
+            .find_map(|k| std::env::var(k).ok()?.parse::<usize>().ok());
+        if rank.is_some_and(|r| r > 0) {
+            SILENT.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        anyhow::bail!(
+            "started as one of {n} MPI ranks, but this peritherm was built without MPI: build it with `cargo build --release --features mpi` (docs/distributed.md)"
+        );
+    }
     let case = peritherm::sweep::load_with(path, set)?;
     let bar = step_bar(quiet);
     let summary = run_case_with(&case, out, options, |done, total| {
@@ -395,6 +408,15 @@ fn run_mpi(
         }
     }
     Ok(())
+}
+
+/// The number of ranks an MPI launcher (`mpiexec` of MPICH or Open MPI, Slurm's `srun`)
+/// started this process among, from the environment it sets; None outside one.
+#[cfg(not(feature = "mpi"))]
+fn launched_ranks() -> Option<usize> {
+    ["PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "SLURM_STEP_NUM_TASKS"]
+        .iter()
+        .find_map(|k| std::env::var(k).ok()?.parse().ok())
 }
 
 /// What `run` prints of a finished run: sizes, steps, time, the implicit counters and the

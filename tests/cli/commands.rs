@@ -603,3 +603,29 @@ fn schema_keys(text: &str) -> Vec<String> {
     }
     keys
 }
+
+/// A build without MPI started by `mpiexec -n 2` refuses to run: two copies would each run the
+/// whole case into the same directory. (The launcher's environment, without the launcher.)
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn a_build_without_mpi_refuses_to_run_as_ranks() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/bar_flux.toml");
+    for (rank, says) in [("0", true), ("1", false)] {
+        let o = crate::common::cli::command()
+            .args(["run", case, "--out", out.to_str().unwrap()])
+            .env("PMI_SIZE", "2")
+            .env("PMI_RANK", rank)
+            .output()
+            .unwrap();
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            err.contains("built without MPI"),
+            says,
+            "rank {rank}: {err}"
+        );
+        assert!(!out.exists());
+    }
+}
