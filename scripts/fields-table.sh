@@ -12,16 +12,7 @@ cd "$(dirname "$0")/.."
 dirs=()
 for f in cases/*.toml; do
   n=$(basename "$f" .toml)
-  settings=$(python3 - "$f" <<'PY'
-import sys, tomllib
-time = tomllib.load(open(sys.argv[1], "rb"))["time"]
-end = time.get("outputs", [time["end"]])[0] / 100
-print(f"time.end={end!r}")
-print(f"time.outputs=[{end!r}]")
-if "dt" in time and time["dt"] > end / 3:
-    print(f"time.dt={end / 3!r}")
-PY
-)
+  settings=$(python3 scripts/short-settings.py "$f")
   args=()
   for s in $settings; do args+=(--set "$s"); done
   "$bin" run "$f" "${args[@]}" --out "out/fields/$n" --quiet >&2

@@ -18,7 +18,6 @@ use mpi::datatype::PartitionMut;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use mpi::Count;
-use std::ops::Range;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
@@ -149,16 +148,8 @@ impl Mpi {
 }
 
 impl Exchange for Mpi {
-    fn rank(&self) -> usize {
-        self.plan.rank
-    }
-
-    fn size(&self) -> usize {
-        self.plan.partition.ranks()
-    }
-
-    fn rows(&self) -> Range<usize> {
-        self.plan.partition.range(self.plan.rank)
+    fn plan(&self) -> &RankPlan {
+        &self.plan
     }
 
     fn halo(&self, field: &mut [f64]) {

@@ -10,6 +10,7 @@
 
 use crate::math::NodeId;
 use crate::operator::Conductance;
+use std::collections::HashSet;
 use std::ops::Range;
 
 /// Work of one row besides its pairs, in pairs (the update, the boundary, the halo copy).
@@ -117,30 +118,28 @@ pub fn closure(
     rows: Range<usize>,
     seeds: &[NodeId],
 ) -> Vec<NodeId> {
-    let mut seen = vec![false; sources.len()];
-    let mut stack: Vec<usize> = Vec::new();
-    let mut visit = |j: usize, stack: &mut Vec<usize>| {
-        if !seen[j] {
-            seen[j] = true;
+    // only the nodes outside the rows are remembered: the work is that of the rows' pairs and
+    // the closure, not of the whole cloud (a rank of thousands plans its halo in its share)
+    let mut seen: HashSet<NodeId> = HashSet::new();
+    let mut stack: Vec<NodeId> = Vec::new();
+    let mut visit = |j: NodeId, stack: &mut Vec<NodeId>| {
+        if !rows.contains(&(j as usize)) && seen.insert(j) {
             stack.push(j);
         }
     };
     let cols = &conductance.cols[conductance.offsets[rows.start]..conductance.offsets[rows.end]];
-    for j in rows
-        .clone()
-        .chain(cols.iter().chain(seeds).map(|&j| j as usize))
-    {
+    let own_sources = rows.clone().flat_map(|i| sources[i].iter());
+    for &j in cols.iter().chain(seeds).chain(own_sources) {
         visit(j, &mut stack);
     }
     while let Some(j) = stack.pop() {
-        for &s in &sources[j] {
-            visit(s as usize, &mut stack);
+        for &s in &sources[j as usize] {
+            visit(s, &mut stack);
         }
     }
-    (0..sources.len())
-        .filter(|&j| seen[j] && !rows.contains(&j))
-        .map(|j| j as NodeId)
-        .collect()
+    let mut out: Vec<NodeId> = seen.into_iter().collect();
+    out.sort_unstable();
+    out
 }
 
 /// The halo of every rank of `partition`: who receives which body nodes from whom, and which
@@ -175,20 +174,23 @@ pub fn halos(
     let mut out = vec![Halo::default(); ranks];
     let mut published = vec![false; n];
     for (r, c) in closures.into_iter().enumerate() {
-        let mut by_owner: Vec<Vec<NodeId>> = vec![Vec::new(); ranks];
+        // sorted ghosts: those of one owner are consecutive (owners hold contiguous rows)
+        let mut groups: Vec<(usize, Vec<NodeId>)> = Vec::new();
         for g in c {
             let gu = g as usize;
             if gu < n_body {
-                by_owner[partition.owner(gu)].push(g);
+                let owner = partition.owner(gu);
+                match groups.last_mut() {
+                    Some((o, nodes)) if *o == owner => nodes.push(g),
+                    _ => groups.push((owner, vec![g])),
+                }
             } else if !std::mem::replace(&mut published[gu], true) {
                 out[r].publish.push(g);
             }
         }
-        for (s, nodes) in by_owner.into_iter().enumerate() {
-            if !nodes.is_empty() {
-                out[s].send.push((r, nodes.clone()));
-                out[r].recv.push((s, nodes));
-            }
+        for (s, nodes) in groups {
+            out[s].send.push((r, nodes.clone()));
+            out[r].recv.push((s, nodes));
         }
     }
     for h in &mut out {

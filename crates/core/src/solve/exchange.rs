@@ -38,12 +38,20 @@ impl Reduce {
 /// The communication of one rank of a distributed run. Every method is collective: all
 /// ranks call it, in the same order, from the thread that steps.
 pub trait Exchange: Sync {
+    /// This rank's rows and halo, and every rank's rows.
+    fn plan(&self) -> &RankPlan;
     /// This rank, from 0.
-    fn rank(&self) -> usize;
+    fn rank(&self) -> usize {
+        self.plan().rank
+    }
     /// Number of ranks.
-    fn size(&self) -> usize;
+    fn size(&self) -> usize {
+        self.plan().partition.ranks()
+    }
     /// The body rows this rank owns.
-    fn rows(&self) -> Range<usize>;
+    fn rows(&self) -> Range<usize> {
+        self.plan().partition.range(self.plan().rank)
+    }
     /// Sets this rank's ghost body entries of `field` (every node, model numbering) to the
     /// values their owners hold.
     fn halo(&self, field: &mut [f64]);
@@ -122,14 +130,8 @@ impl InProcess {
 }
 
 impl Exchange for InProcess {
-    fn rank(&self) -> usize {
-        self.plan.rank
-    }
-    fn size(&self) -> usize {
-        self.plan.partition.ranks()
-    }
-    fn rows(&self) -> Range<usize> {
-        self.plan.partition.range(self.plan.rank)
+    fn plan(&self) -> &RankPlan {
+        &self.plan
     }
     fn halo(&self, field: &mut [f64]) {
         self.publish(field, false);
