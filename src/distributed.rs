@@ -111,8 +111,7 @@ impl Mpi {
         let mut counts = Vec::with_capacity(plans.len());
         for p in plans {
             let before = gathered.len();
-            gathered.extend(p.partition.range(p.rank));
-            gathered.extend(p.halo.publish.iter().map(|&j| j as usize));
+            gathered.extend(p.gathered());
             counts.push((gathered.len() - before) as Count);
         }
         let displs = counts
@@ -137,13 +136,6 @@ impl Mpi {
             buffers: Mutex::new(buffers),
             seconds: AtomicU64::new(0),
         }
-    }
-}
-
-impl Mpi {
-    /// Time spent in halo exchanges so far, s.
-    fn seconds(&self) -> f64 {
-        f64::from_bits(self.seconds.load(Ordering::Relaxed))
     }
 }
 
@@ -185,7 +177,7 @@ impl Exchange for Mpi {
         for (&v, &j) in recv.iter().zip(ghosts) {
             field[j as usize] = v;
         }
-        let spent = self.seconds() + started.elapsed().as_secs_f64();
+        let spent = self.exchange_seconds() + started.elapsed().as_secs_f64();
         self.seconds.store(spent.to_bits(), Ordering::Relaxed);
     }
 
@@ -217,7 +209,7 @@ impl Exchange for Mpi {
         y
     }
 
-    fn traffic(&self) -> (usize, f64) {
-        (self.plan.halo.ghosts(), self.seconds())
+    fn exchange_seconds(&self) -> f64 {
+        f64::from_bits(self.seconds.load(Ordering::Relaxed))
     }
 }

@@ -343,18 +343,7 @@ fn run(
         return run_mpi(&env, path, set, out, quiet, options);
     }
     #[cfg(not(feature = "mpi"))]
-    if let Some(n) = launched_ranks().filter(|&n| n > 1) {
-        // N copies would each run the whole case into the same directory; the first says so
-        let rank = ["PMI_RANK", "OMPI_COMM_WORLD_RANK", "SLURM_PROCID"]
-            .iter()
-            .find_map(|k| std::env::var(k).ok()?.parse::<usize>().ok());
-        if rank.is_some_and(|r| r > 0) {
-            SILENT.store(true, std::sync::atomic::Ordering::Relaxed);
-        }
-        anyhow::bail!(
-            "started as one of {n} MPI ranks, but this peritherm was built without MPI: build it with `cargo build --release --features mpi` (docs/distributed.md)"
-        );
-    }
+    refuse_as_ranks()?;
     let case = peritherm::sweep::load_with(path, set)?;
     let bar = step_bar(quiet);
     let summary = run_case_with(&case, out, options, |done, total| {
@@ -410,12 +399,29 @@ fn run_mpi(
     Ok(())
 }
 
-/// The number of ranks an MPI launcher (`mpiexec` of MPICH or Open MPI, Slurm's `srun`)
-/// started this process among, from the environment it sets; None outside one.
+/// Refuses to run when an MPI launcher started this build, which has no MPI, as one of
+/// several ranks: N copies would each run the whole case into the same directory.
 #[cfg(not(feature = "mpi"))]
-fn launched_ranks() -> Option<usize> {
-    ["PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "SLURM_STEP_NUM_TASKS"]
-        .iter()
+fn refuse_as_ranks() -> anyhow::Result<()> {
+    let size = launcher_says(&["PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "SLURM_STEP_NUM_TASKS"]);
+    if let Some(n) = size.filter(|&n| n > 1) {
+        // N copies would each run the whole case into the same directory; the first says so
+        let rank = launcher_says(&["PMI_RANK", "OMPI_COMM_WORLD_RANK", "SLURM_PROCID"]);
+        if rank.is_some_and(|r| r > 0) {
+            SILENT.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        anyhow::bail!(
+            "started as one of {n} MPI ranks, but this peritherm was built without MPI: build it with `cargo build --release --features mpi` (docs/distributed.md)"
+        );
+    }
+    Ok(())
+}
+
+/// A number an MPI launcher (`mpiexec` of MPICH or Open MPI, Slurm's `srun`) sets in the
+/// environment under one of `keys` (the size or the rank); None outside one.
+#[cfg(not(feature = "mpi"))]
+fn launcher_says(keys: &[&str]) -> Option<usize> {
+    keys.iter()
         .find_map(|k| std::env::var(k).ok()?.parse().ok())
 }
 

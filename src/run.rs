@@ -137,15 +137,20 @@ fn follow(case: &Case, model: &Model, plan: Plan, exchange: &dyn Exchange) -> Re
         |_, _, _, _, _| peer(agree(Some(exchange), true)),
         |_, _| {},
     )?;
-    exchange.reduce(exchange.traffic().1, Reduce::Max);
+    longest_exchange(exchange);
     Ok(())
+}
+
+/// The longest time any rank spent in halo exchanges, s: the last collective of a run, which
+/// rank 0 calls in [`ranks`] and the others at the end of [`follow`].
+fn longest_exchange(exchange: &dyn Exchange) -> f64 {
+    exchange.reduce(exchange.exchange_seconds(), Reduce::Max)
 }
 
 /// Per-rank sizes of a distributed run for run.json (a collective: the longest exchange time
 /// is reduced over the ranks).
 fn ranks(model: &Model, rank: &Rank) -> Ranks {
-    let ex = rank.exchange;
-    let exchange_seconds = ex.reduce(ex.traffic().1, Reduce::Max);
+    let exchange_seconds = longest_exchange(rank.exchange);
     let off = &model.conductance.offsets;
     let rows = |p: &RankPlan| p.partition.range(p.rank);
     Ranks {
@@ -180,12 +185,12 @@ fn execute(
         total, mut engine, ..
     } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
+    // first, so that a run that fails or is interrupted also says which case it was
+    let origin = crate::provenance::write_copy(out, case);
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let t_run = Instant::now();
-    // first, so that a run that fails or is interrupted also says which case it was
-    let ready = crate::provenance::write_copy(out, case)
-        .and_then(|origin| Ok((origin, OutputWriter::new(case, model, out)?)));
+    let ready = origin.and_then(|origin| Ok((origin, OutputWriter::new(case, model, out)?)));
     if !agree(ex, ready.is_ok()) {
         return Err(ready.err().unwrap_or(Error::Peer));
     }

@@ -2,6 +2,7 @@
 //! one process ([`InProcess`], the protocol of the MPI build without MPI). Called for every
 //! bundled case by [`crate::bundled`]; the MPI build's own tests run the same under `mpiexec`.
 
+use crate::common::runs::same_field_files;
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::run::run_ranked;
@@ -36,19 +37,6 @@ pub fn run_in_process(
     first.expect("rank 0 writes the summary")
 }
 
-/// The files `serial` wrote for its fields (CSV and VTU), read from `serial_dir` and
-/// `other_dir`, are equal byte for byte.
-pub fn same_fields(serial_dir: &Path, other_dir: &Path, fields: &[String], what: &str) {
-    for f in fields {
-        let vtu = f.replace(".csv", ".vtu");
-        for name in [f.as_str(), vtu.as_str()] {
-            let a = std::fs::read(serial_dir.join(name)).unwrap();
-            let b = std::fs::read(other_dir.join(name)).unwrap();
-            assert!(a == b, "{what}: {name} differs from the serial run's");
-        }
-    }
-}
-
 /// Runs `case` distributed over 2 and 3 in-process ranks and checks the fields against the
 /// serial run in `serial_dir` (run.json lists them). Steppers that are not distributed (each
 /// rank steps the whole model) run over 2 ranks when their serial run took under a second
@@ -68,7 +56,7 @@ pub fn same_as_serial(case: &Case, model: &Model, serial_dir: &Path, serial_seco
         assert_eq!(r.size, ranks);
         assert_eq!(r.nodes.iter().sum::<usize>(), model.cloud.n_body);
         let what = format!("{} on {ranks} ranks ({})", case.path.display(), r.mode);
-        same_fields(serial_dir, out.path(), &serial.fields, &what);
+        same_field_files(serial_dir, out.path(), &serial.fields, &what);
         // both as run.json has them (serde_json's parse of a float may differ in its last bit
         // from the value written, the same way for both)
         let read = peritherm::output::RunSummary::read(out.path()).unwrap();

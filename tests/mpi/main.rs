@@ -11,9 +11,11 @@
 #[allow(dead_code)]
 mod common {
     pub mod cli;
+    pub mod runs;
 }
 
 use common::cli::{command, EXE};
+use common::runs::same_field_files;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -92,17 +94,8 @@ fn same_under_mpiexec(case: &str) {
         let r = s.ranks.expect("run.json of an MPI run lists its ranks");
         assert_eq!(r.size, ranks, "{case}: the communicator's size");
         assert_eq!(r.nodes.iter().sum::<usize>(), s.nodes, "{case}");
-        for f in &fields {
-            for name in [f.clone(), f.replace(".csv", ".vtu")] {
-                let a = std::fs::read(serial.join(&name)).unwrap();
-                let b = std::fs::read(out.join(&name)).unwrap();
-                assert!(
-                    a == b,
-                    "{case} on {ranks} ranks ({}): {name} differs",
-                    r.mode
-                );
-            }
-        }
+        let what = format!("{case} on {ranks} ranks ({})", r.mode);
+        same_field_files(&serial, &out, &fields, &what);
     }
 }
 

@@ -61,8 +61,8 @@ pub trait Exchange: Sync {
     fn all_gather(&self, field: &mut [f64]);
     /// `x` combined over the ranks by `op`, the same on every rank.
     fn reduce(&self, x: f64, op: Reduce) -> f64;
-    /// Values received per [`Exchange::halo`] and the time spent in it so far, s.
-    fn traffic(&self) -> (usize, f64);
+    /// Time spent in [`Exchange::halo`] so far on this rank, s.
+    fn exchange_seconds(&self) -> f64;
 }
 
 /// The body rows and halo of one rank of a partition: what a rank needs to take part.
@@ -110,11 +110,9 @@ impl InProcess {
             .collect()
     }
 
-    /// Publishes this rank's rows (and, when gathering, its fictitious nodes).
-    fn publish(&self, field: &[f64], fictitious: bool) {
-        let extra = self.plan.halo.publish.iter().map(|&j| j as usize);
-        let extra = extra.take(if fictitious { usize::MAX } else { 0 });
-        for i in self.rows().chain(extra) {
+    /// Publishes the entries `nodes` of `field` this rank holds current.
+    fn publish(&self, field: &[f64], nodes: impl Iterator<Item = usize>) {
+        for i in nodes {
             self.shared.field[i].store(field[i].to_bits(), Ordering::Relaxed);
         }
         self.shared.barrier.wait();
@@ -134,17 +132,14 @@ impl Exchange for InProcess {
         &self.plan
     }
     fn halo(&self, field: &mut [f64]) {
-        self.publish(field, false);
+        self.publish(field, self.rows());
         let ghosts = self.plan.halo.recv.iter().flat_map(|(_, n)| n.iter());
         self.read(field, ghosts.map(|&j: &NodeId| j as usize));
     }
     fn all_gather(&self, field: &mut [f64]) {
-        self.publish(field, true);
-        let rows = self.rows();
-        let mine = &self.plan.halo.publish;
-        let others = (0..self.shared.field.len())
-            .filter(|j| !rows.contains(j) && mine.binary_search(&(*j as NodeId)).is_err());
-        self.read(field, others);
+        self.publish(field, self.plan.gathered());
+        // every node has exactly one publisher (its own entries come back unchanged)
+        self.read(field, 0..self.shared.field.len());
     }
     fn reduce(&self, x: f64, op: Reduce) -> f64 {
         self.shared.slots[self.rank()].store(x.to_bits(), Ordering::Relaxed);
@@ -154,8 +149,8 @@ impl Exchange for InProcess {
         self.shared.barrier.wait();
         v
     }
-    fn traffic(&self) -> (usize, f64) {
-        (self.plan.halo.ghosts(), 0.0)
+    fn exchange_seconds(&self) -> f64 {
+        0.0
     }
 }
 
@@ -167,7 +162,6 @@ impl RankPlan {
         let partition = Partition::by_work(k, ranks);
         let rules = model.boundary.linear_rules();
         let sources = crate::partition::rule_sources(model.cloud.len(), &rules);
-        debug_assert_eq!(sources.len(), model.cloud.len());
         crate::partition::halos(k, &sources, model.cloud.n_body, &partition)
             .into_iter()
             .enumerate()
@@ -177,5 +171,12 @@ impl RankPlan {
                 halo,
             })
             .collect()
+    }
+
+    /// The nodes this rank gives the others when the whole field is gathered: its rows, then
+    /// the fictitious nodes it publishes ([`Halo::publish`]).
+    pub fn gathered(&self) -> impl Iterator<Item = usize> + '_ {
+        let publish = self.halo.publish.iter().map(|&j| j as usize);
+        self.partition.range(self.rank).chain(publish)
     }
 }

@@ -46,11 +46,11 @@ fn rates_with(
     let driven = &model.boundary.driven;
     let mine = &mut out[rows.clone()];
     if let Some(st) = stencils {
-        st.for_rows(theta, mine, rows, |i, s, o| {
+        st.for_rows(theta, mine, rows.clone(), |i, s, o| {
             *o = if driven[i] { 0.0 } else { s * inv[i] };
         });
     } else {
-        csr_rows(k, theta, rows, mine, |i, s, _, o| {
+        csr_rows(k, theta, rows.clone(), driven, mine, |i, s, _, o| {
             *o = if driven[i] { 0.0 } else { s * inv[i] };
         });
     }
@@ -58,7 +58,7 @@ fn rates_with(
         model
             .boundary
             .add_loads(&model.cloud, &model.capacity, theta, t, out);
-        for (o, &d) in out.iter_mut().zip(driven) {
+        for (o, &d) in out[rows.clone()].iter_mut().zip(&driven[rows]) {
             if d {
                 *o = 0.0;
             }
@@ -67,12 +67,14 @@ fn rates_with(
 }
 
 /// Calls `f(i, Σ_j K_ij (θ_j − θ_i), θ_i, out_i)` for every body row `i` of `rows` through the
-/// plain CSR rows of K, in parallel tasks of [`ROW_CHUNK`] rows (`out` holds the rows `rows`).
+/// plain CSR rows of K, in parallel tasks of [`ROW_CHUNK`] rows (`out` holds the rows `rows`);
+/// the sum is not formed (0 is passed) for the rows marked in `skip` (driven nodes).
 #[inline(always)]
 fn csr_rows(
     k: &Conductance,
     theta: &[f64],
     rows: Range<usize>,
+    skip: &[bool],
     out: &mut [f64],
     f: impl Fn(usize, f64, f64, &mut f64) + Sync,
 ) {
@@ -84,7 +86,10 @@ fn csr_rows(
             for (r, (o, w)) in o.iter_mut().zip(off.windows(2)).enumerate() {
                 let i = first + r;
                 let ti = theta[i];
-                let s = row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti);
+                let s = match skip[i] {
+                    true => 0.0,
+                    false => row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti),
+                };
                 f(i, s, ti, o);
             }
         });
@@ -112,7 +117,7 @@ fn euler_fused(
         });
         return;
     }
-    csr_rows(k, theta, rows, next, |i, s, ti, o| {
+    csr_rows(k, theta, rows, driven, next, |i, s, ti, o| {
         *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
     });
 }
@@ -270,46 +275,30 @@ impl<'a> Explicit<'a> {
 
     /// One classical RK4 step of the rows of this stepper (the constraints set at each stage).
     fn rk4(&mut self, theta: &mut [f64], t: f64, h: f64) {
-        let (m, k, rows, ex) = (
-            self.model,
-            &*self.conductance,
-            self.rows.clone(),
-            self.exchange,
-        );
+        let (m, k, ex) = (self.model, &*self.conductance, self.exchange);
+        let r = self.rows.clone();
         let [k1, k2, k3, k4] = &mut self.k;
-        let r = rows.clone();
-        let mut stage = std::mem::take(&mut self.stage);
+        let stage = &mut self.stage;
         rates(m, k, theta, t, r.clone(), k1);
         stage.copy_from_slice(theta);
-        axpy(
-            &mut stage[r.clone()],
-            &theta[r.clone()],
-            0.5 * h,
-            &k1[r.clone()],
-        );
-        constrain(m, ex, &mut stage, t + 0.5 * h);
-        rates(m, k, &stage, t + 0.5 * h, r.clone(), k2);
-        axpy(
-            &mut stage[r.clone()],
-            &theta[r.clone()],
-            0.5 * h,
-            &k2[r.clone()],
-        );
-        constrain(m, ex, &mut stage, t + 0.5 * h);
-        rates(m, k, &stage, t + 0.5 * h, r.clone(), k3);
-        axpy(&mut stage[r.clone()], &theta[r.clone()], h, &k3[r.clone()]);
-        constrain(m, ex, &mut stage, t + h);
-        rates(m, k, &stage, t + h, r.clone(), k4);
+        axpy(stage, theta, 0.5 * h, k1, r.clone());
+        constrain(m, ex, stage, t + 0.5 * h);
+        rates(m, k, stage, t + 0.5 * h, r.clone(), k2);
+        axpy(stage, theta, 0.5 * h, k2, r.clone());
+        constrain(m, ex, stage, t + 0.5 * h);
+        rates(m, k, stage, t + 0.5 * h, r.clone(), k3);
+        axpy(stage, theta, h, k3, r.clone());
+        constrain(m, ex, stage, t + h);
+        rates(m, k, stage, t + h, r.clone(), k4);
         let h6 = h / 6.0;
-        theta[rows.clone()]
+        theta[r.clone()]
             .par_iter_mut()
             .with_min_len(4096)
-            .zip(&k1[rows.clone()])
-            .zip(&k2[rows.clone()])
-            .zip(&k3[rows.clone()])
-            .zip(&k4[rows])
+            .zip(&k1[r.clone()])
+            .zip(&k2[r.clone()])
+            .zip(&k3[r.clone()])
+            .zip(&k4[r])
             .for_each(|((((y, a), b), c), d)| *y += h6 * (a + 2.0 * (b + c) + d));
-        self.stage = stage;
     }
 
     /// Integrates from `t0` through each output time, calling `on_output(k, t, θ, K)` there and
@@ -398,10 +387,12 @@ fn update(y: &mut [f64], x: &[f64], f: impl Fn(&mut f64, f64) + Sync) {
         });
 }
 
-fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64]) {
-    out.par_chunks_mut(ROW_CHUNK)
-        .zip(y.par_chunks(ROW_CHUNK))
-        .zip(k.par_chunks(ROW_CHUNK))
+/// `out_i = y_i + a·k_i` for the rows `rows`, in parallel tasks of [`ROW_CHUNK`].
+fn axpy(out: &mut [f64], y: &[f64], a: f64, k: &[f64], rows: Range<usize>) {
+    out[rows.clone()]
+        .par_chunks_mut(ROW_CHUNK)
+        .zip(y[rows.clone()].par_chunks(ROW_CHUNK))
+        .zip(k[rows].par_chunks(ROW_CHUNK))
         .for_each(|((o, y), k)| {
             for ((o, y), k) in o.iter_mut().zip(y).zip(k) {
                 *o = y + a * k;
