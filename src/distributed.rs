@@ -1,20 +1,24 @@
 //! Distributed runs through MPI (cargo feature `mpi`: the `mpi` crate, rsmpi, over MPICH or
 //! Open MPI): `mpiexec -n N peritherm run CASE --out DIR` runs the case file unchanged.
 //!
-//! Every rank reads the case and builds the model (set-up is not yet distributed: each rank
-//! holds the whole model), cuts the rows by work ([`RankPlan::all`], the same on every rank,
-//! no messages) and steps its own rows, exchanging ghost temperatures before each boundary
-//! application ([`Mpi`] implements [`Exchange`]). Rank 0 writes the outputs, bit for bit those
-//! of a serial run ([`crate::run::run_ranked`]).
+//! Every rank reads the case and builds the cloud, cuts the body rows into contiguous ranges
+//! by estimated work (the same cut on every rank, no messages), and then, when the case
+//! allows it, builds only the bonds and K of its own rows with the margin their assembly
+//! reads ([`crate::prepare::build_rank`]); otherwise (consistent weights, cracks, phase
+//! change, implicit or adaptive steps) every rank builds the whole model. Each rank plans its
+//! halo, swaps the lists with the others, and steps its own rows, exchanging ghost
+//! temperatures before each boundary application ([`Mpi`] implements [`Exchange`]). Rank 0
+//! writes the outputs, bit for bit those of a serial run ([`crate::run::run_ranked`]).
 
 use crate::case::Case;
 use crate::error::Result;
+use crate::math::NodeId;
 use crate::output::RunSummary;
 use crate::prepare::Options;
 use crate::run::run_ranked;
-use crate::solve::exchange::{Exchange, RankPlan, Reduce};
+use crate::solve::exchange::{publishers_of, Collective, Exchange, NodeLists, RankPlan, Reduce};
 use mpi::collective::SystemOperation;
-use mpi::datatype::PartitionMut;
+use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use mpi::Count;
@@ -53,8 +57,9 @@ impl Environment {
         (cores / on_node).max(1)
     }
 
-    /// Runs `case` as this rank: builds the model, plans the ranks and runs
-    /// ([`run_ranked`]); rank 0 writes `out` and returns the summary.
+    /// Runs `case` as this rank: builds its share of the model, or the whole model, and its
+    /// plan ([`crate::prepare::build_rank`]), then runs ([`run_ranked`]); rank 0 writes `out`
+    /// and returns the summary.
     pub fn run(
         &self,
         case: &Case,
@@ -63,10 +68,11 @@ impl Environment {
         progress: impl FnMut(u64, u64),
     ) -> Result<Option<RunSummary>> {
         let started = Instant::now();
-        let model = crate::prepare::build(case, options)?;
-        let plans = RankPlan::all(&model, self.size());
-        let exchange = Mpi::new(self.universe.world(), &plans, model.cloud.len());
-        run_ranked(case, &model, out, started, &exchange, &plans, progress)
+        let comm = Comm(World(self.universe.world()));
+        let (model, plan) = crate::prepare::build_rank(case, options, &comm)?;
+        let publish = publishers_of(&model, &plan.partition);
+        let exchange = Mpi::new(comm, plan, &publish);
+        run_ranked(case, &model, out, started, &exchange, progress)
     }
 }
 
@@ -80,9 +86,79 @@ struct World(SimpleCommunicator);
 unsafe impl Send for World {}
 unsafe impl Sync for World {}
 
+/// [`Collective`] over an MPI communicator.
+pub struct Comm(World);
+
+impl Collective for Comm {
+    fn rank(&self) -> usize {
+        self.0 .0.rank() as usize
+    }
+
+    fn size(&self) -> usize {
+        self.0 .0.size() as usize
+    }
+
+    fn reduce(&self, x: f64, op: Reduce) -> f64 {
+        let mut y = 0.0;
+        let op = match op {
+            Reduce::Sum => SystemOperation::sum(),
+            Reduce::Min => SystemOperation::min(),
+            Reduce::Max => SystemOperation::max(),
+        };
+        self.0 .0.all_reduce_into(&x, &mut y, op);
+        y
+    }
+
+    fn swap(&self, lists: &NodeLists) -> NodeLists {
+        let world = &self.0 .0;
+        let n = self.size();
+        let mut counts = vec![0 as Count; n];
+        for (to, nodes) in lists {
+            counts[*to] = nodes.len() as Count;
+        }
+        let mut incoming = vec![0 as Count; n];
+        world.all_to_all_into(&counts[..], &mut incoming[..]);
+        let displs = |c: &[Count]| -> Vec<Count> {
+            c.iter()
+                .scan(0, |at, &k| {
+                    let d = *at;
+                    *at += k;
+                    Some(d)
+                })
+                .collect()
+        };
+        let mut send: Vec<NodeId> = Vec::with_capacity(counts.iter().sum::<Count>() as usize);
+        let mut by_rank: Vec<&[NodeId]> = vec![&[]; n];
+        for (to, nodes) in lists {
+            by_rank[*to] = nodes;
+        }
+        by_rank
+            .iter()
+            .for_each(|nodes| send.extend_from_slice(nodes));
+        let mut recv = vec![0 as NodeId; incoming.iter().sum::<Count>() as usize];
+        let (sd, rd) = (displs(&counts), displs(&incoming));
+        let sent = Partition::new(&send[..], &counts[..], &sd[..]);
+        let mut got = PartitionMut::new(&mut recv[..], &incoming[..], &rd[..]);
+        world.all_to_all_varcount_into(&sent, &mut got);
+        (0..n)
+            .filter(|&r| incoming[r] > 0)
+            .map(|r| {
+                let at = rd[r] as usize;
+                (r, recv[at..at + incoming[r] as usize].to_vec())
+            })
+            .collect()
+    }
+
+    fn gather_counts(&self, x: u64) -> Vec<u64> {
+        let mut all = vec![0u64; self.size()];
+        self.0 .0.all_gather_into(&x, &mut all[..]);
+        all
+    }
+}
+
 /// [`Exchange`] over an MPI communicator.
 pub struct Mpi {
-    world: World,
+    comm: Comm,
     plan: RankPlan,
     /// The nodes of the gathered field in the order the ranks send them: each rank's rows,
     /// then the fictitious nodes it publishes.
@@ -104,14 +180,15 @@ struct Buffers {
 }
 
 impl Mpi {
-    /// The exchange of this rank of `world` over `plans` (every rank's), for `n_nodes` nodes.
-    pub fn new(world: SimpleCommunicator, plans: &[RankPlan], n_nodes: usize) -> Mpi {
-        let plan = plans[world.rank() as usize].clone();
-        let mut gathered = Vec::with_capacity(n_nodes);
-        let mut counts = Vec::with_capacity(plans.len());
-        for p in plans {
+    /// The exchange of this rank of `comm` with its `plan`, given the fictitious nodes every
+    /// rank publishes (`publish`, by rank: [`crate::partition::publishers`]).
+    pub fn new(comm: Comm, plan: RankPlan, publish: &[Vec<NodeId>]) -> Mpi {
+        let mut gathered = Vec::new();
+        let mut counts = Vec::with_capacity(publish.len());
+        for (r, p) in publish.iter().enumerate() {
             let before = gathered.len();
-            gathered.extend(p.gathered());
+            gathered.extend(plan.partition.range(r));
+            gathered.extend(p.iter().map(|&j| j as usize));
             counts.push((gathered.len() - before) as Count);
         }
         let displs = counts
@@ -128,7 +205,7 @@ impl Mpi {
             gather: vec![0.0; gathered.len()],
         };
         Mpi {
-            world: World(world),
+            comm,
             plan,
             gathered,
             counts,
@@ -136,6 +213,28 @@ impl Mpi {
             buffers: Mutex::new(buffers),
             seconds: AtomicU64::new(0),
         }
+    }
+
+    fn world(&self) -> &SimpleCommunicator {
+        &self.comm.0 .0
+    }
+}
+
+impl Collective for Mpi {
+    fn rank(&self) -> usize {
+        self.comm.rank()
+    }
+    fn size(&self) -> usize {
+        self.comm.size()
+    }
+    fn reduce(&self, x: f64, op: Reduce) -> f64 {
+        self.comm.reduce(x, op)
+    }
+    fn swap(&self, lists: &NodeLists) -> NodeLists {
+        self.comm.swap(lists)
+    }
+    fn gather_counts(&self, x: u64) -> Vec<u64> {
+        self.comm.gather_counts(x)
     }
 }
 
@@ -160,12 +259,12 @@ impl Exchange for Mpi {
             for (r, nodes) in &halo.recv {
                 let (mine, tail) = std::mem::take(&mut rest).split_at_mut(nodes.len());
                 rest = tail;
-                let from = self.world.0.process_at_rank(*r as i32);
+                let from = self.world().process_at_rank(*r as i32);
                 pending.push(from.immediate_receive_into(scope, mine));
             }
             let mut at = 0;
             for (r, nodes) in &halo.send {
-                let to = self.world.0.process_at_rank(*r as i32);
+                let to = self.world().process_at_rank(*r as i32);
                 to.send(&send[at..at + nodes.len()]);
                 at += nodes.len();
             }
@@ -190,23 +289,11 @@ impl Exchange for Mpi {
             *s = field[j];
         }
         let mut parts = PartitionMut::new(&mut gather[..], &self.counts[..], &self.displs[..]);
-        self.world
-            .0
+        self.world()
             .all_gather_varcount_into(&send[..mine.len()], &mut parts);
         for (&v, &j) in gather.iter().zip(&self.gathered) {
             field[j] = v;
         }
-    }
-
-    fn reduce(&self, x: f64, op: Reduce) -> f64 {
-        let mut y = 0.0;
-        let op = match op {
-            Reduce::Sum => SystemOperation::sum(),
-            Reduce::Min => SystemOperation::min(),
-            Reduce::Max => SystemOperation::max(),
-        };
-        self.world.0.all_reduce_into(&x, &mut y, op);
-        y
     }
 
     fn exchange_seconds(&self) -> f64 {

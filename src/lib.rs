@@ -19,7 +19,7 @@
 
 pub use peritherm_core::{
     analytic, bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model,
-    neighbors, operator, solve, spatial, stencil, symmetry, weights,
+    neighbors, operator, partition, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{
     atomic, case, gmsh, history, output, provenance, reference, series, staging,
@@ -31,6 +31,7 @@ pub mod bench;
 pub mod distributed;
 pub mod fem;
 pub mod figures;
+pub mod planner;
 pub mod prepare;
 pub mod run;
 pub mod simulation;

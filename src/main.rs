@@ -176,6 +176,33 @@ enum Command {
         /// The case file (TOML).
         case: PathBuf,
     },
+    /// Print what each of N MPI ranks would hold and exchange in a run of a case (nodes,
+    /// ghosts, bonds, memory, halo bytes) and a time per step from a latency–bandwidth model,
+    /// without running it (docs/distributed.md).
+    Partition {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Rank counts, comma-separated (e.g. 1,64,4096).
+        #[arg(long, value_delimiter = ',', required = true, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+        ranks: Vec<u32>,
+        /// Memory bandwidth of one rank (its share of a node's), GB/s.
+        #[arg(long, default_value_t = 5.0, value_parser = parse_positive)]
+        bandwidth: f64,
+        /// Latency of a message between ranks, µs.
+        #[arg(long, default_value_t = 2.0, value_parser = parse_positive)]
+        latency: f64,
+        /// Bandwidth of the link between ranks, GB/s.
+        #[arg(long, default_value_t = 12.5, value_parser = parse_positive)]
+        link: f64,
+    },
+}
+
+/// Parses a finite positive number of a model parameter.
+fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a finite positive number")),
+    }
 }
 
 /// Parses a time scheme of `peritherm fem` by its run.json name ([`Scheme::from_name`]).
@@ -302,7 +329,34 @@ fn dispatch(
             bench(&opts, json.as_deref(), &command)
         }
         Command::Check { case } => check(&case, options),
+        Command::Partition {
+            case,
+            ranks,
+            bandwidth,
+            latency,
+            link,
+        } => {
+            let machine = peritherm::planner::Machine {
+                bandwidth,
+                latency,
+                link,
+            };
+            let ranks: Vec<usize> = ranks.into_iter().map(|n| n as usize).collect();
+            partition(&case, &ranks, &machine)
+        }
     }
+}
+
+/// `peritherm partition`: the plan of a case on each rank count, as a Markdown table.
+fn partition(
+    path: &std::path::Path,
+    ranks: &[usize],
+    machine: &peritherm::planner::Machine,
+) -> anyhow::Result<()> {
+    let case = Case::load(path)?;
+    let rows = peritherm::planner::plan(&case, ranks, machine)?;
+    say!("{}", peritherm::planner::markdown(&case, &rows, machine));
+    Ok(())
 }
 
 /// The settings of `peritherm fem`: the element size `h` (m) of a box case, the scheme and the

@@ -8,6 +8,7 @@ use crate::cloud::FACE_NAMES;
 use crate::error::{Error, Result};
 use crate::limits::MAX_STEPS;
 use crate::model::{Geometry, Model};
+use crate::solve::exchange::{Collective, RankPlan, Reduce};
 use crate::solve::implicit::Adaptive;
 use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
 
@@ -65,6 +66,14 @@ pub fn build(case: &Case, options: &Options) -> Result<Model> {
 /// without bonds (a horizon below the spacing), two nodes at one point (a duplicated mesh
 /// element), and a stable step that vanishes.
 pub fn semantic(case: &Case, model: &Model) -> Result<()> {
+    regions_have_nodes(case, model)?;
+    let (count, first) = lonely(model);
+    no_lonely(model, count, first)?;
+    duplicates(case, model)
+}
+
+/// Refuses a region without nodes (no element of the mesh's group, or no cell).
+fn regions_have_nodes(case: &Case, model: &Model) -> Result<()> {
     let cloud = &model.cloud;
     let regions = match &case.spec.geometry {
         Geometry::Box(g) => g.regions.len(),
@@ -82,24 +91,81 @@ pub fn semantic(case: &Case, model: &Model) -> Result<()> {
             "the region has no nodes (no element of the mesh's group, or no cell)",
         ));
     }
-    let lonely: Vec<usize> = (0..cloud.n_body)
-        .filter(|&i| model.horizons.row(i).next().is_none())
-        .collect();
-    if let Some(&i) = lonely.first() {
-        return Err(Error::model(
-            format!("region[{}].horizon", cloud.region[i]),
-            format!(
-                "{} of {} body nodes have no bond (first at ({}, {}, {}) m, spacing {:e} m, horizon {:e} m): the horizon must reach the neighbouring nodes",
-                lonely.len(),
-                cloud.n_body,
-                cloud.pos[i].x,
-                cloud.pos[i].y,
-                cloud.pos[i].z,
-                cloud.spacing[i],
-                cloud.horizon[i]
-            ),
-        ));
+    Ok(())
+}
+
+/// The body nodes of the model's rows without a bond: how many, and the first.
+fn lonely(model: &Model) -> (usize, Option<usize>) {
+    let mut nodes = model
+        .rows
+        .clone()
+        .filter(|&i| model.horizons.row(i).is_empty());
+    let first = nodes.next();
+    (first.map_or(0, |_| 1 + nodes.count()), first)
+}
+
+/// Refuses `count` body nodes without a bond, the first of them `first`.
+fn no_lonely(model: &Model, count: usize, first: Option<usize>) -> Result<()> {
+    let Some(i) = first else {
+        return Ok(());
+    };
+    let cloud = &model.cloud;
+    Err(Error::model(
+        format!("region[{}].horizon", cloud.region[i]),
+        format!(
+            "{} of {} body nodes have no bond (first at ({}, {}, {}) m, spacing {:e} m, horizon {:e} m): the horizon must reach the neighbouring nodes",
+            count,
+            cloud.n_body,
+            cloud.pos[i].x,
+            cloud.pos[i].y,
+            cloud.pos[i].z,
+            cloud.spacing[i],
+            cloud.horizon[i]
+        ),
+    ))
+}
+
+/// Whether `case` runs distributed with each rank building its share of the model
+/// ([`Model::build_share`]): a shareable model stepped explicitly at a fixed step.
+pub fn shares(case: &Case) -> bool {
+    Model::shareable(&case.spec) && !case.integrator.is_implicit() && case.tolerance.is_none()
+}
+
+/// One rank's model and plan in a distributed run over `link`: its share of the model when
+/// [`shares`] allows it (the budget per rank, the checks reduced over the ranks, the stable
+/// bound of every rank's rows), else the whole model with every rank's plan computed alike.
+/// Every rank fails alike: what differs between ranks is reduced first.
+pub fn build_rank(
+    case: &Case,
+    options: &Options,
+    link: &dyn Collective,
+) -> Result<(Model, RankPlan)> {
+    if !shares(case) {
+        let model = build(case, options)?;
+        let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
+        return Ok((model, plan));
     }
+    case.budget
+        .per_rank(link.size())
+        .enforce(options.max_memory)
+        .map_err(|message| case.error(&case.budget.key, message))?;
+    let (mut model, partition) =
+        Model::build_share(&case.spec, link.size(), link.rank()).map_err(|e| keyed(case, e))?;
+    let (count, first) = lonely(&model);
+    let count = link.reduce(count as f64, Reduce::Sum) as usize;
+    let first = link.reduce(first.map_or(f64::INFINITY, |i| i as f64), Reduce::Min);
+    let first = first.is_finite().then_some(first as usize);
+    semantic_share(case, &model, count, first).map_err(|e| keyed(case, e))?;
+    let lambda = link.reduce(model.lambda_max(), Reduce::Max);
+    model.set_lambda_max(lambda);
+    let plan = RankPlan::of_share(&model, partition, link);
+    Ok((model, plan))
+}
+
+/// [`semantic`] of a share, given the nodes without a bond over every rank.
+fn semantic_share(case: &Case, model: &Model, count: usize, first: Option<usize>) -> Result<()> {
+    regions_have_nodes(case, model)?;
+    no_lonely(model, count, first)?;
     duplicates(case, model)
 }
 

@@ -14,7 +14,7 @@ use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, Ranks, R
 use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
-use crate::solve::exchange::{Exchange, RankPlan, Reduce};
+use crate::solve::exchange::{Exchange, Reduce};
 use crate::solve::{integrate, Engine, Integrator, RunStats, Schedule};
 use crate::staging::{reached, write_into};
 use std::path::Path;
@@ -59,24 +59,22 @@ pub fn run_model(
 pub struct Rank<'a> {
     /// The communication with the other ranks.
     pub exchange: &'a dyn Exchange,
-    /// Every rank's rows and halo ([`RankPlan::all`]).
-    pub plans: &'a [RankPlan],
     /// `rows` when the stepper is distributed, `replicated` when every rank steps it all.
     pub mode: &'static str,
 }
 
-/// Runs `case` on its built `model` as one rank of a distributed run over `exchange`
-/// (`plans`: every rank's rows and halo, [`RankPlan::all`]): explicit runs step their rows
-/// only ([`crate::solve::explicit::Explicit::distribute`]), the other steppers step the whole
-/// model on every rank. Rank 0 writes `out` as a serial run would, with the same bits, and
-/// returns the summary; the other ranks return None. A rank that fails stops all of them.
+/// Runs `case` on this rank's `model` (a share, or the whole model:
+/// [`crate::prepare::build_rank`]) as one rank of a distributed run over `exchange`:
+/// explicit runs step their rows only ([`crate::solve::explicit::Explicit::distribute`]), the
+/// other steppers step the whole model on every rank. Rank 0 writes `out` as a serial run
+/// would, with the same bits, and returns the summary; the other ranks return None. A rank
+/// that fails stops all of them.
 pub fn run_ranked<'a>(
     case: &Case,
     model: &'a Model,
     out: &Path,
     t_setup: Instant,
     exchange: &'a dyn Exchange,
-    plans: &'a [RankPlan],
     progress: impl FnMut(u64, u64),
 ) -> Result<Option<RunSummary>> {
     let mut plan = plan(case, model)?;
@@ -87,13 +85,9 @@ pub fn run_ranked<'a>(
         }
         _ => "replicated",
     };
-    let rank = Rank {
-        exchange,
-        plans,
-        mode,
-    };
+    let rank = Rank { exchange, mode };
     if exchange.rank() != 0 {
-        return follow(case, model, plan, exchange).map(|_| None);
+        return follow(case, model, plan, &rank).map(|_| None);
     }
     let mut entered = false;
     let name = case.path.display().to_string();
@@ -108,6 +102,31 @@ pub fn run_ranked<'a>(
     done.map(Some)
 }
 
+/// The heat flux of every body node at an output (W/m²): a share computes its own rows and
+/// the ranks gather them (a collective then); a whole model computes them all.
+fn output_flux(
+    model: &Model,
+    theta: &[f64],
+    conductance: &Conductance,
+    exchange: Option<&dyn Exchange>,
+) -> Vec<crate::math::Vector> {
+    let mut flux = conductance.flux(&model.cloud, theta);
+    let Some(ex) = exchange.filter(|_| model.rows != (0..model.cloud.n_body)) else {
+        return flux;
+    };
+    let mut part = vec![0.0; model.cloud.len()];
+    for axis in 0..3 {
+        for (p, q) in part.iter_mut().zip(&flux) {
+            *p = q[axis];
+        }
+        ex.all_gather(&mut part);
+        for (q, p) in flux.iter_mut().zip(&part) {
+            q[axis] = *p;
+        }
+    }
+    flux
+}
+
 /// True on every rank when `ok` on all ranks (a collective, [`Exchange::reduce`]); a
 /// serial run (no exchange) agrees with itself.
 fn agree(exchange: Option<&dyn Exchange>, ok: bool) -> bool {
@@ -119,7 +138,8 @@ fn agree(exchange: Option<&dyn Exchange>, ok: bool) -> bool {
 
 /// The time loop of a rank other than 0: the same steps and collectives as rank 0's
 /// ([`execute`]), no output.
-fn follow(case: &Case, model: &Model, plan: Plan, exchange: &dyn Exchange) -> Result<()> {
+fn follow(case: &Case, model: &Model, plan: Plan, rank: &Rank) -> Result<()> {
+    let exchange = rank.exchange;
     let schedule = plan.schedule();
     let Plan { mut engine, .. } = plan;
     if !agree(Some(exchange), true) {
@@ -134,36 +154,43 @@ fn follow(case: &Case, model: &Model, plan: Plan, exchange: &dyn Exchange) -> Re
         &mut theta,
         0.0,
         &times,
-        |_, _, _, _, _| peer(agree(Some(exchange), true)),
+        |k, _, th, conductance, _| {
+            if output_index(&case.outputs, times[k]).is_some() {
+                output_flux(model, th, conductance, Some(exchange));
+            }
+            peer(agree(Some(exchange), true))
+        },
         |_, _| {},
     )?;
-    longest_exchange(exchange);
+    ranks(model, rank);
     Ok(())
 }
 
-/// The longest time any rank spent in halo exchanges, s: the last collective of a run, which
-/// rank 0 calls in [`ranks`] and the others at the end of [`follow`].
-fn longest_exchange(exchange: &dyn Exchange) -> f64 {
-    exchange.reduce(exchange.exchange_seconds(), Reduce::Max)
-}
-
-/// Per-rank sizes of a distributed run for run.json (a collective: the longest exchange time
-/// is reduced over the ranks).
+/// Per-rank sizes of a distributed run for run.json: the last collective of a run, which
+/// rank 0 calls after its time loop and the others at the end of [`follow`].
 fn ranks(model: &Model, rank: &Rank) -> Ranks {
-    let exchange_seconds = longest_exchange(rank.exchange);
+    let ex = rank.exchange;
+    let exchange_seconds = ex.reduce(ex.exchange_seconds(), Reduce::Max);
+    let rows = ex.rows();
     let off = &model.conductance.offsets;
-    let rows = |p: &RankPlan| p.partition.range(p.rank);
+    let each = |x: usize| -> Vec<usize> {
+        let all = ex.gather_counts(x as u64);
+        all.into_iter().map(|v| v as usize).collect()
+    };
+    let ghosts = each(ex.plan().halo.ghosts());
+    let bonds = each(model.bonds_into(rows.clone()));
     Ranks {
-        size: rank.plans.len(),
+        size: ex.size(),
         mode: rank.mode.into(),
-        nodes: rank.plans.iter().map(|p| rows(p).len()).collect(),
-        ghosts: rank.plans.iter().map(|p| p.halo.ghosts()).collect(),
-        pairs: rank
-            .plans
-            .iter()
-            .map(|p| off[rows(p).end] - off[rows(p).start])
-            .collect(),
-        halo_bytes: rank.plans.iter().map(|p| p.halo.ghosts() * 8).sum(),
+        nodes: each(rows.len()),
+        pairs: each(off[rows.end] - off[rows.start]),
+        halo_bytes: ghosts.iter().sum::<usize>() * 8,
+        ghosts,
+        bonds,
+        setup: match model.rows == (0..model.cloud.n_body) {
+            true => "whole".into(),
+            false => "share".into(),
+        },
         exchange_seconds,
     }
 }
@@ -207,7 +234,10 @@ fn execute(
             r.record(t, th);
         }
         let written = match output_index(&case.outputs, times[k]) {
-            Some(f) => writer.write(f, t, th, conductance, e),
+            Some(f) => {
+                let flux = output_flux(model, th, conductance, ex);
+                writer.write_with_flux(f, t, th, &flux, e)
+            }
             None => Ok(()),
         };
         match (agree(ex, written.is_ok()), written) {
@@ -249,6 +279,14 @@ fn execute(
     summary.initial_energy = initial_energy;
     summary.history = history;
     summary.origin = Some(origin);
+    if let Some(r) = ranks
+        .as_ref()
+        .filter(|_| model.rows != (0..model.cloud.n_body))
+    {
+        // a share holds its own rows' bonds: the model's are those of every rank
+        summary.bonds = r.bonds.iter().sum();
+        summary.pairs = r.pairs.iter().sum();
+    }
     summary.ranks = ranks;
     summary.write(out)?;
     Ok(summary)

@@ -1,30 +1,43 @@
 //! A distributed run gives the serial run's files, bit for bit: ranks simulated by threads of
-//! one process ([`InProcess`], the protocol of the MPI build without MPI). Called for every
+//! one process ([`InProcessLink`], the protocol of the MPI build without MPI), each building its
+//! share of the model where the case allows it. Called for every
 //! bundled case by [`crate::bundled`]; the MPI build's own tests run the same under `mpiexec`.
 
 use crate::common::runs::same_field_files;
 use peritherm::case::Case;
 use peritherm::model::Model;
+use peritherm::prepare::{build_rank, shares, Options};
 use peritherm::run::run_ranked;
-use peritherm::solve::exchange::{InProcess, RankPlan};
+use peritherm::solve::exchange::{InProcessLink, RankPlan};
 use std::path::Path;
 use std::time::Instant;
 
-/// Runs `case` on `model` over `ranks` in-process ranks into `out`; rank 0's summary.
+/// Runs `case` over `ranks` in-process ranks into `out`; rank 0's summary. Each rank builds
+/// its share of the model when the case allows it ([`peritherm::prepare::build_rank`]), else
+/// they share the whole `model`, as the MPI ranks would each build it.
 pub fn run_in_process(
     case: &Case,
     model: &Model,
     ranks: usize,
     out: &Path,
 ) -> peritherm::output::RunSummary {
-    let plans = RankPlan::all(model, ranks);
-    let group = InProcess::group(plans.clone(), model.cloud.len());
-    let plans = &plans;
+    let links = InProcessLink::group(ranks, model.cloud.len());
+    let whole = RankPlan::all(model, ranks);
     let summaries: Vec<_> = std::thread::scope(|s| {
-        let handles: Vec<_> = group
-            .iter()
-            .map(|ex| {
-                s.spawn(move || run_ranked(case, model, out, Instant::now(), ex, plans, |_, _| {}))
+        let handles: Vec<_> = links
+            .into_iter()
+            .zip(whole)
+            .map(|(link, plan)| {
+                s.spawn(move || {
+                    let started = Instant::now();
+                    if !shares(case) {
+                        let ex = link.with_plan(plan);
+                        return run_ranked(case, model, out, started, &ex, |_, _| {});
+                    }
+                    let (share, plan) = build_rank(case, &Options::default(), &link)?;
+                    let ex = link.with_plan(plan);
+                    run_ranked(case, &share, out, started, &ex, |_, _| {})
+                })
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
@@ -55,7 +68,16 @@ pub fn same_as_serial(case: &Case, model: &Model, serial_dir: &Path, serial_seco
         let r = s.ranks.as_ref().expect("ranks in run.json");
         assert_eq!(r.size, ranks);
         assert_eq!(r.nodes.iter().sum::<usize>(), model.cloud.n_body);
-        let what = format!("{} on {ranks} ranks ({})", case.path.display(), r.mode);
+        let setup = if shares(case) { "share" } else { "whole" };
+        assert_eq!(r.setup, setup, "{}", case.path.display());
+        // the shares' bonds add up to the whole model's
+        assert_eq!(r.bonds.iter().sum::<usize>(), model.horizons.n_bonds());
+        assert_eq!((s.bonds, s.pairs), (serial.bonds, serial.pairs));
+        let what = format!(
+            "{} on {ranks} ranks ({}, {setup})",
+            case.path.display(),
+            r.mode
+        );
         same_field_files(serial_dir, out.path(), &serial.fields, &what);
         // both as run.json has them (serde_json's parse of a float may differ in its last bit
         // from the value written, the same way for both)

@@ -83,7 +83,13 @@ fn same_under_mpiexec(case: &str) {
         "{case}: {}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let fields = peritherm::output::RunSummary::read(&serial).unwrap().fields;
+    let serial_run = peritherm::output::RunSummary::read(&serial).unwrap();
+    let fields = serial_run.fields.clone();
+    // a shareable case is built one share per rank, the others whole on every rank
+    let setup = match peritherm::prepare::shares(&peritherm::case::Case::load(&path).unwrap()) {
+        true => "share",
+        false => "whole",
+    };
     for ranks in [1, 2, 3] {
         let out = dir.path().join(format!("ranks-{ranks}"));
         let a = with_out(&out);
@@ -94,7 +100,14 @@ fn same_under_mpiexec(case: &str) {
         let r = s.ranks.expect("run.json of an MPI run lists its ranks");
         assert_eq!(r.size, ranks, "{case}: the communicator's size");
         assert_eq!(r.nodes.iter().sum::<usize>(), s.nodes, "{case}");
-        let what = format!("{case} on {ranks} ranks ({})", r.mode);
+        let setup = if ranks == 1 { "whole" } else { setup };
+        assert_eq!(r.setup, setup, "{case} on {ranks} ranks");
+        assert_eq!(
+            (s.bonds, s.pairs),
+            (serial_run.bonds, serial_run.pairs),
+            "{case}"
+        );
+        let what = format!("{case} on {ranks} ranks ({}, {setup})", r.mode);
         same_field_files(&serial, &out, &fields, &what);
     }
 }

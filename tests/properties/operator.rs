@@ -591,3 +591,62 @@ fn abrupt_horizon_jumps_are_corrected_with_positive_conductances() {
     assert!(c.min_ratio > 0.0 && c.after < 1e-10, "{c:?}");
     assert_eq!(c.uncorrected, 0, "{c:?}");
 }
+
+/// Each rank's share of a dual-horizon model with fictitious layers ([`Model::build_share`],
+/// 1 to 5 ranks) holds the rows of K of its range with the bits of the whole model's (columns,
+/// values, row sums) and nothing else, its bonds add up to the whole model's, and the halo it
+/// plans alone equals the one planned from the whole model. Exact: the same sums in the same
+/// order.
+#[test]
+fn a_share_holds_the_whole_models_rows_bit_for_bit() {
+    use peritherm::partition::{own_halo, publishers, rule_sources};
+    use peritherm::solve::exchange::RankPlan;
+    let mut spec = dual_horizon_case(MIRROR_FACES, "lattice").spec;
+    let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
+        panic!("a box case")
+    };
+    for r in &mut g.regions {
+        r.cells[0] *= 2;
+        r.cells[1] *= 2;
+    }
+    assert!(Model::shareable(&spec));
+    let whole = Model::build(&spec).unwrap();
+    let k = &whole.conductance;
+    for ranks in 1..=5 {
+        let plans = RankPlan::all(&whole, ranks);
+        let mut bonds = 0;
+        for (rank, plan) in plans.iter().enumerate() {
+            let (share, partition) = Model::build_share(&spec, ranks, rank).unwrap();
+            assert_eq!(partition, plan.partition);
+            let rows = partition.range(rank);
+            assert_eq!(share.rows, rows);
+            let s = &share.conductance;
+            assert_eq!(s.nnz(), k.offsets[rows.end] - k.offsets[rows.start]);
+            for i in 0..whole.cloud.n_body {
+                let (a, b) = (
+                    s.offsets[i]..s.offsets[i + 1],
+                    k.offsets[i]..k.offsets[i + 1],
+                );
+                if !rows.contains(&i) {
+                    assert!(a.is_empty() && s.diag[i] == 0.0, "{ranks} ranks: row {i}");
+                    continue;
+                }
+                assert_eq!(s.cols[a.clone()], k.cols[b.clone()], "row {i}");
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&s.vals[a]), bits(&k.vals[b]), "row {i}");
+                assert_eq!(s.diag[i].to_bits(), k.diag[i].to_bits(), "row {i}");
+            }
+            bonds += share.bonds_into(rows.clone());
+            // the halo a share plans alone is the one of the whole model (sends aside)
+            let sources = rule_sources(share.cloud.len(), &share.boundary.linear_rules());
+            let nb = share.cloud.n_body;
+            let publish = publishers(&sources, nb, &partition).swap_remove(rank);
+            let own = own_halo(s, &sources, nb, &partition, rank, publish);
+            assert_eq!(
+                (&own.recv, &own.publish),
+                (&plan.halo.recv, &plan.halo.publish)
+            );
+        }
+        assert_eq!(bonds, whole.horizons.n_bonds(), "{ranks} ranks");
+    }
+}

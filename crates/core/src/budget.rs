@@ -8,6 +8,7 @@ use crate::kernel::PartialVolume;
 use crate::limits::{
     BYTES_PER_BOND, BYTES_PER_NODE, CORRECTION_BYTES_PER_ENTRY, FEM_BYTES_PER_ENTRY,
     IMPLICIT_BOND_FACTOR, MAX_DIRECT_ENTRIES, MAX_NEIGHBOURS, MEMORY_FRACTION,
+    SHARED_BYTES_PER_NODE,
 };
 use crate::model::{Geometry, ModelSpec};
 use crate::weights::Order;
@@ -263,6 +264,13 @@ fn box_regions(g: &BoxGeometry, layered: &[bool], band: f64) -> Vec<(f64, f64, f
         .collect()
 }
 
+/// Bytes of one rank that builds its share of a model ([`crate::model::Model::build_share`]):
+/// [`BYTES_PER_NODE`] per row and [`BYTES_PER_BOND`] per bond of its share, plus
+/// [`SHARED_BYTES_PER_NODE`] for each of the `all_nodes` nodes of the cloud, B.
+pub fn share_bytes(rows: f64, bonds: f64, all_nodes: f64) -> f64 {
+    rows * BYTES_PER_NODE + bonds * BYTES_PER_BOND + all_nodes * SHARED_BYTES_PER_NODE
+}
+
 impl Estimate {
     /// Refuses when the estimate exceeds `limit` bytes, or, without one, the fraction
     /// [`MEMORY_FRACTION`] of the machine's available memory; the message states the
@@ -292,6 +300,16 @@ impl Estimate {
             self.fictitious,
             self.bonds
         ))
+    }
+
+    /// The estimate for one of `ranks` ranks that each build their share of the model
+    /// ([`share_bytes`] of an even share).
+    pub fn per_rank(&self, ranks: usize) -> Estimate {
+        let (nodes, r) = (self.nodes + self.fictitious, ranks.max(1) as f64);
+        Estimate {
+            bytes: share_bytes(nodes / r, self.bonds / r, nodes),
+            ..self.clone()
+        }
     }
 
     /// One line for `check`: the estimate.

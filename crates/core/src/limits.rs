@@ -34,6 +34,10 @@ pub const MAX_HISTORY_ROWS: f64 = 1e6;
 /// boundary's tables and the search structures): a conservative round figure, not a
 /// measurement (about fifty f64 per node).
 pub const BYTES_PER_NODE: f64 = 1024.0;
+/// Bytes per node that every rank of a distributed run holds whatever its share: the cloud
+/// (positions, volumes, spacing, horizon, regions: about 70 B), the gathered temperature and
+/// flux, the halo plan, B.
+pub const SHARED_BYTES_PER_NODE: f64 = 200.0;
 
 /// Bytes per directed bond at the peak of the set-up (neighbour lists of the search pass,
 /// bond weights and cut fractions, and the conductance's CSR column and value): about 40 B

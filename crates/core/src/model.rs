@@ -13,8 +13,10 @@ use crate::material::{BondRule, Enthalpy, Material};
 use crate::math::Point;
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
+use crate::partition::Partition;
 use crate::symmetry::Symmetry;
 use crate::weights::{correct, Consistency, Order};
+use std::ops::Range;
 
 /// Initial temperature field.
 #[derive(Debug, Clone)]
@@ -217,6 +219,12 @@ pub struct Model {
     pub growth: Vec<PairCut>,
     /// Cuts of the directed bonds by cracks alone (for damage).
     pub crack_cuts: Cuts,
+    /// The body rows whose bonds and K this model holds: all of them, or one rank's share
+    /// ([`Model::build_share`]).
+    pub rows: Range<usize>,
+    /// The bound of [`Model::lambda_max`] over every rank's rows, once a share has been told
+    /// it ([`Model::set_lambda_max`]), 1/s.
+    pub shared_lambda: Option<f64>,
 }
 
 /// A pair that a growing crack cuts at `time`: its K entries keep the fraction `mu`.
@@ -347,6 +355,7 @@ impl Bonds {
         horizons: &Horizons,
         layered: &[bool],
         bond_conductivity: &[f64],
+        rows: Range<usize>,
     ) -> Bonds {
         let mut weights = directed_weights(
             cloud,
@@ -370,7 +379,7 @@ impl Bonds {
         for (w, m) in weights.iter_mut().zip(mu) {
             *w *= m;
         }
-        let mut conductance = Conductance::assemble(cloud, horizons, &weights);
+        let mut conductance = Conductance::assemble_rows(cloud, horizons, &weights, rows);
         let (correction, consistent) =
             if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
                 let sel = complete_horizons(cloud, horizons, layered, mu);
@@ -438,34 +447,130 @@ fn heat_properties(
     (enthalpy, conductivity, capacity)
 }
 
+/// The boundary of `cloud` (`heat`: conductivity and capacity per node; `micro`: the bonds'
+/// micro-conductances, for nodal flux relations).
+fn boundary_of(
+    spec: &ModelSpec,
+    cloud: &Cloud,
+    phase: bool,
+    heat: (&[f64], &[f64]),
+    micro: Option<(&Horizons, &[f64])>,
+) -> Boundary {
+    // with phase change the loads are enthalpy rates (W/m³): unit capacity
+    let unit = vec![1.0; if phase { cloud.len() } else { 0 }];
+    Boundary::build(BoundaryInput {
+        cloud,
+        faces: spec.faces.clone(),
+        conductivity: heat.0,
+        capacity: if phase { &unit } else { heat.1 },
+        micro,
+        source: spec.source.clone(),
+    })
+}
+
 impl Model {
-    /// Builds cloud, bonds, conductance and boundary from a spec.
-    pub fn build(spec: &ModelSpec) -> Result<Model> {
+    /// The cloud and boundary of a spec without any bond (for planning a distributed run:
+    /// [`crate::partition::loads`]); nodal flux relations get no micro-conductances.
+    pub fn outline(spec: &ModelSpec) -> Result<(Cloud, Boundary)> {
         let phase = check_spec(spec)?;
         let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
         let cloud = build_cloud(spec, &layered)?;
         let mat = |i: usize| spec.materials[cloud.material[i] as usize];
         let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
         let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
+        let boundary = boundary_of(spec, &cloud, phase, (&conductivity, &capacity), None);
+        Ok((cloud, boundary))
+    }
+
+    /// Builds cloud, bonds, conductance and boundary from a spec.
+    pub fn build(spec: &ModelSpec) -> Result<Model> {
+        let phase = check_spec(spec)?;
+        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
+        let cloud = build_cloud(spec, &layered)?;
         let horizons = Horizons::build(&cloud, &spec.kernel);
+        let rows = 0..cloud.n_body;
+        Self::finish(spec, cloud, horizons, phase, &layered, rows)
+    }
+
+    /// Whether a spec can be built one rank's share at a time ([`Model::build_share`]): every
+    /// row of K depends on its own neighbourhood only. Not so for the consistent weights (one
+    /// global solve), cracks (damage and growth read every row), nodal flux relations (their
+    /// micro-conductances) and phase change (its stepper is not distributed).
+    pub fn shareable(spec: &ModelSpec) -> bool {
+        let corrected = spec.consistency != Order::None && !spec.symmetry.is_symmetric();
+        let relation = spec
+            .faces
+            .iter()
+            .any(|f| matches!(f, FaceBc::RelationFlux { .. }));
+        let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
+        !(corrected || relation || phase || !spec.cracks.is_empty())
+    }
+
+    /// The share of rank `rank` of `ranks` of a [`Model::shareable`] spec, and the partition
+    /// of the body rows ([`Partition::by_estimate`], the same on every rank): the whole cloud
+    /// (positions, volumes, boundary: O(nodes)), but the bonds and K of the rank's rows
+    /// alone, with the margin of rows their assembly reads ([`Horizons::build_rows`]). Its
+    /// rows have the bits of [`Model::build`]'s; the others are empty.
+    pub fn build_share(spec: &ModelSpec, ranks: usize, rank: usize) -> Result<(Model, Partition)> {
+        let phase = check_spec(spec)?;
+        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
+        let cloud = build_cloud(spec, &layered)?;
+        let partition = Partition::by_estimate(&cloud, ranks);
+        let rows = partition.range(rank.min(partition.ranks() - 1));
+        let horizons = Horizons::build_rows(&cloud, &spec.kernel, rows.clone());
+        let model = Self::finish(spec, cloud, horizons, phase, &layered, rows)?;
+        Ok((model, partition))
+    }
+
+    /// Tells a share the bound of [`Model::lambda_max`] over every rank (their largest), 1/s.
+    pub fn set_lambda_max(&mut self, lambda: f64) {
+        self.shared_lambda = Some(lambda);
+    }
+
+    /// Bonds of the body rows `rows` (held by this model), plus the bonds from fictitious
+    /// nodes into them: summed over the ranges of a partition, the bonds of the whole model.
+    pub fn bonds_into(&self, rows: Range<usize>) -> usize {
+        let h = &self.horizons;
+        let rows = &rows;
+        let body = h.offsets[rows.end] - h.offsets[rows.start];
+        let fictitious: usize = (self.cloud.n_body..h.len())
+            .map(|f| {
+                let t = &h.targets[h.row(f)];
+                t.iter().filter(|&&i| rows.contains(&(i as usize))).count()
+            })
+            .sum();
+        body + fictitious
+    }
+
+    /// The model of `cloud` and `horizons`, its K assembled on `rows`.
+    fn finish(
+        spec: &ModelSpec,
+        cloud: Cloud,
+        horizons: Horizons,
+        phase: bool,
+        layered: &[bool],
+        rows: Range<usize>,
+    ) -> Result<Model> {
+        let mat = |i: usize| spec.materials[cloud.material[i] as usize];
+        let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
+        let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
         // with phase change, K for unit conductivity; λ̄_ij(t) scales it as the state evolves
         let bond_conductivity = if phase {
             vec![1.0; cloud.len()]
         } else {
             conductivity.clone()
         };
-        let bonds = Bonds::build(spec, &cloud, &horizons, &layered, &bond_conductivity);
+        let bonds = Bonds::build(
+            spec,
+            &cloud,
+            &horizons,
+            layered,
+            &bond_conductivity,
+            rows.clone(),
+        );
         let micro = bonds.micro(spec, &cloud, &horizons);
-        // with phase change the loads are enthalpy rates (W/m³): unit capacity
-        let unit = vec![1.0; if phase { cloud.len() } else { 0 }];
-        let boundary = Boundary::build(BoundaryInput {
-            cloud: &cloud,
-            faces: spec.faces.clone(),
-            conductivity: &conductivity,
-            capacity: if phase { &unit } else { &capacity },
-            micro: micro.as_deref().map(|m| (&horizons, m)),
-            source: spec.source.clone(),
-        });
+        let micro = micro.as_deref().map(|m| (&horizons, m));
+        let boundary = boundary_of(spec, &cloud, phase, (&conductivity, &capacity), micro);
         let (enthalpy, conductivity, capacity) =
             heat_properties(spec, &cloud, phase, conductivity, capacity);
         let inv_heat_capacity = (0..cloud.n_body)
@@ -496,6 +601,8 @@ impl Model {
             consistent,
             growth,
             crack_cuts,
+            rows,
+            shared_lambda: None,
         })
     }
 
@@ -535,6 +642,9 @@ impl Model {
     /// With phase change K holds unit conductivities and the loads are per unit capacity, so
     /// the bound takes the largest conductivity and the smallest capacity of any phase.
     pub fn lambda_max(&self) -> f64 {
+        if let Some(l) = self.shared_lambda {
+            return l;
+        }
         let loads = self.boundary.load_diagonal(self.cloud.n_body);
         let (k_max, load_scale) = match self.enthalpy {
             Some(_) => (self.conductivity.iter().copied().fold(0.0, f64::max), true),

@@ -130,6 +130,17 @@ enum Finder {
 }
 
 impl Finder {
+    /// The bucket grid when `grid` and it pays ([`Grid::new`]), else a k-d tree; `pts` is
+    /// not empty.
+    fn new(pts: &[[f64; 3]], reach: &[f64], grid: bool) -> Finder {
+        match grid.then(|| Grid::new(pts, reach)).flatten() {
+            Some(g) => Finder::Grid(g),
+            None => Finder::Tree(
+                ImmutableKdTree::new_from_slice(pts).expect("a non-empty cloud builds a k-d tree"),
+            ),
+        }
+    }
+
     fn within(&self, pts: &[[f64; 3]], i: usize, r2: f64, out: &mut Vec<NodeId>) {
         match self {
             Finder::Grid(g) => g.within(pts, &pts[i], r2, out),
@@ -143,6 +154,61 @@ impl Finder {
             ),
         }
     }
+}
+
+/// β of the bond i → j, None when it is not a bond (j outside H_i, j = i, or both fictitious).
+fn bond(cloud: &Cloud, kernel: &Kernel, i: usize, j: usize) -> Option<f64> {
+    let nb = cloud.n_body;
+    if j == i || (i >= nb && j >= nb) {
+        return None;
+    }
+    let r = (cloud.pos[j] - cloud.pos[i]).norm();
+    let (beta, _) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
+    (beta > 0.0).then_some(beta)
+}
+
+/// What the body rows of one range hold, counted by the search alone (nothing stored).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RowCensus {
+    /// Entries of K in the rows (pairs).
+    pub pairs: usize,
+    /// Directed bonds of the rows, and from fictitious nodes into them.
+    pub bonds: usize,
+    /// The columns of the rows outside them (body or fictitious), sorted.
+    pub outside: Vec<NodeId>,
+}
+
+/// [`RowCensus`] of the rows `rows`, searching around each at the largest reach `rmax`.
+fn census_of(
+    cloud: &Cloud,
+    kernel: &Kernel,
+    finder: &Finder,
+    pts: &[[f64; 3]],
+    rmax: f64,
+    rows: std::ops::Range<usize>,
+) -> RowCensus {
+    let r2 = rmax * rmax * (1.0 + 1e-12);
+    let mut c = RowCensus::default();
+    let mut near = Vec::new();
+    for i in rows.clone() {
+        near.clear();
+        finder.within(pts, i, r2, &mut near);
+        for &j in &near {
+            let ju = j as usize;
+            let out = bond(cloud, kernel, i, ju).is_some();
+            let into = bond(cloud, kernel, ju, i).is_some();
+            if out || into {
+                c.pairs += 1;
+                if !rows.contains(&ju) {
+                    c.outside.push(j);
+                }
+            }
+            c.bonds += out as usize + (into && ju >= cloud.n_body) as usize;
+        }
+    }
+    c.outside.sort_unstable();
+    c.outside.dedup();
+    c
 }
 
 /// Search radius of every node: its horizon plus the partial-volume band of the coarsest spacing.
@@ -162,6 +228,7 @@ fn search_blocks<F>(
     pts: &[[f64; 3]],
     reach: &[f64],
     keep: &F,
+    wanted: Option<&[bool]>,
     lens: &mut [usize],
 ) -> Vec<Vec<NodeId>>
 where
@@ -175,6 +242,10 @@ where
             let mut found = Vec::new();
             for (r, len) in lens.iter_mut().enumerate() {
                 let i = first + r;
+                if wanted.is_some_and(|w| !w[i]) {
+                    *len = 0;
+                    continue;
+                }
                 found.clear();
                 finder.within(pts, i, reach[i] * reach[i] * (1.0 + 1e-12), &mut found);
                 found.retain(|&j| keep(i, j as usize).is_some());
@@ -186,6 +257,44 @@ where
             list
         })
         .collect()
+}
+
+/// Marks the rows `rows` and every node j with a bond j → i into one of them (`keep(j, i)`),
+/// found by searching around each i at the largest reach of the cloud.
+fn reaching<F>(
+    finder: &Finder,
+    pts: &[[f64; 3]],
+    reach: &[f64],
+    keep: &F,
+    rows: std::ops::Range<usize>,
+) -> Vec<bool>
+where
+    F: Fn(usize, usize) -> Option<f64> + Sync,
+{
+    let rmax = reach.iter().cloned().fold(0.0, f64::max);
+    let r2 = rmax * rmax * (1.0 + 1e-12);
+    let found: Vec<Vec<NodeId>> = rows
+        .clone()
+        .into_par_iter()
+        .chunks(SEARCH_CHUNK)
+        .map(|chunk| {
+            let (mut near, mut out) = (Vec::new(), Vec::new());
+            for i in chunk {
+                near.clear();
+                finder.within(pts, i, r2, &mut near);
+                out.extend(near.iter().filter(|&&j| keep(j as usize, i).is_some()));
+            }
+            out.sort_unstable();
+            out.dedup();
+            out
+        })
+        .collect();
+    let mut wanted = vec![false; pts.len()];
+    wanted[rows].iter_mut().for_each(|w| *w = true);
+    for j in found.into_iter().flatten() {
+        wanted[j as usize] = true;
+    }
+    wanted
 }
 
 /// The targets and β of each of `n_blocks` blocks of [`SEARCH_CHUNK`] rows, as disjoint
@@ -233,6 +342,24 @@ impl Horizons {
     /// [`Horizons::build`] with the bucket grid allowed or not (the k-d tree always works;
     /// both give the same lists).
     pub fn build_with(cloud: &Cloud, kernel: &Kernel, grid: bool) -> Self {
+        Self::search(cloud, kernel, grid, None)
+    }
+
+    /// The rows a rank needs to assemble the body rows `rows` of K bit for bit as a whole
+    /// model would (dual horizon: the margin comes from the other side's δ): those rows, and
+    /// every node j (body or fictitious) whose horizon holds one of them, for w_ji. Every
+    /// other row is left empty. The search is that of [`Horizons::build`] over those rows.
+    pub fn build_rows(cloud: &Cloud, kernel: &Kernel, rows: std::ops::Range<usize>) -> Self {
+        Self::search(cloud, kernel, true, Some(rows))
+    }
+
+    /// The search of [`Horizons::build_with`]; with `rows`, that of [`Horizons::build_rows`].
+    fn search(
+        cloud: &Cloud,
+        kernel: &Kernel,
+        grid: bool,
+        rows: Option<std::ops::Range<usize>>,
+    ) -> Self {
         let pts: Vec<[f64; 3]> = cloud.pos.iter().map(|p| [p.x, p.y, p.z]).collect();
         let n = pts.len();
         if n == 0 {
@@ -242,25 +369,12 @@ impl Horizons {
             };
         }
         let reach = reaches(cloud, kernel);
-        let finder = match grid.then(|| Grid::new(&pts, &reach)).flatten() {
-            Some(g) => Finder::Grid(g),
-            None => Finder::Tree(
-                ImmutableKdTree::new_from_slice(&pts).expect("a non-empty cloud builds a k-d tree"),
-            ),
-        };
-        let nb = cloud.n_body;
-        // β of the bond i -> j, None when it is not a bond
-        let keep = |i: usize, j: usize| -> Option<f64> {
-            if j == i || (i >= nb && j >= nb) {
-                return None;
-            }
-            let r = (cloud.pos[j] - cloud.pos[i]).norm();
-            let (beta, _) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
-            (beta > 0.0).then_some(beta)
-        };
+        let finder = Finder::new(&pts, &reach, grid);
+        let keep = |i: usize, j: usize| bond(cloud, kernel, i, j);
+        let wanted = rows.map(|rows| reaching(&finder, &pts, &reach, &keep, rows));
         // pass 1: sorted neighbour lists of each block of rows, and the row lengths
         let mut lens = vec![0usize; n];
-        let blocks = search_blocks(&finder, &pts, &reach, &keep, &mut lens);
+        let blocks = search_blocks(&finder, &pts, &reach, &keep, wanted.as_deref(), &mut lens);
         drop(finder);
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0usize);
@@ -293,6 +407,27 @@ impl Horizons {
                 }
             });
         h
+    }
+
+    /// [`RowCensus`] of each range of body rows in `ranges` (one rank's each, say), from
+    /// one search structure, the ranges in parallel: what [`Horizons::build_rows`] and the
+    /// assembly would give each, without holding any bond.
+    pub fn census(
+        cloud: &Cloud,
+        kernel: &Kernel,
+        ranges: &[std::ops::Range<usize>],
+    ) -> Vec<RowCensus> {
+        let pts: Vec<[f64; 3]> = cloud.pos.iter().map(|p| [p.x, p.y, p.z]).collect();
+        if pts.is_empty() {
+            return vec![RowCensus::default(); ranges.len()];
+        }
+        let reach = reaches(cloud, kernel);
+        let rmax = reach.iter().cloned().fold(0.0, f64::max);
+        let finder = Finder::new(&pts, &reach, true);
+        ranges
+            .par_iter()
+            .map(|r| census_of(cloud, kernel, &finder, &pts, rmax, r.clone()))
+            .collect()
     }
 
     /// Number of nodes (rows).

@@ -12,6 +12,7 @@ use crate::material::BondRule;
 use crate::math::{NodeId, Vector};
 use crate::neighbors::Horizons;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Symmetric pair conductances in CSR form, rows for the body nodes only, W/K.
 #[derive(Debug, Clone, Default)]
@@ -141,7 +142,12 @@ fn find(row: &[NodeId], i: NodeId, guess: usize) -> Option<usize> {
 /// The bonds j → i into a body node i that has no bond i → j, as (i, j, w_ji) sorted by
 /// (i, j); none when every node has the same horizon and spacing (β_ij = β_ji: the relation
 /// is symmetric). In parallel.
-fn lone_bonds(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Vec<(NodeId, NodeId, f64)> {
+fn lone_bonds(
+    cloud: &Cloud,
+    horizons: &Horizons,
+    weights: &[f64],
+    rows: &Range<usize>,
+) -> Vec<(NodeId, NodeId, f64)> {
     let n = horizons.len();
     let nb = cloud.n_body;
     let targets = &horizons.targets;
@@ -156,7 +162,7 @@ fn lone_bonds(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Vec<(NodeI
             let start = horizons.offsets[j];
             out.iter().enumerate().filter_map(move |(p, &i)| {
                 let iu = i as usize;
-                if iu >= nb {
+                if iu >= nb || !rows.contains(&iu) {
                     return None;
                 }
                 let back = row(iu);
@@ -177,6 +183,7 @@ fn lone_bonds(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Vec<(NodeI
 fn row_offsets(
     horizons: &Horizons,
     nb: usize,
+    rows: &Range<usize>,
     lone: &[(NodeId, NodeId, f64)],
 ) -> (Vec<usize>, Vec<usize>) {
     let mut lone_off = vec![0usize; nb + 1];
@@ -189,7 +196,10 @@ fn row_offsets(
     let mut offsets = Vec::with_capacity(nb + 1);
     offsets.push(0usize);
     for i in 0..nb {
-        let len = horizons.row(i).len() + lone_off[i + 1] - lone_off[i];
+        let len = match rows.contains(&i) {
+            true => horizons.row(i).len() + lone_off[i + 1] - lone_off[i],
+            false => 0,
+        };
         offsets.push(offsets[i] + len);
     }
     (lone_off, offsets)
@@ -200,11 +210,23 @@ impl Conductance {
     /// transpose): K_ij = w_ij + w_ji with w_ji found in row j, plus the bonds j → i whose
     /// reverse does not exist (at horizon changes), collected separately.
     pub fn assemble(cloud: &Cloud, horizons: &Horizons, weights: &[f64]) -> Self {
+        Self::assemble_rows(cloud, horizons, weights, 0..cloud.n_body)
+    }
+
+    /// [`Conductance::assemble`] of the body rows `rows` alone (one rank's share, from the
+    /// rows of [`Horizons::build_rows`]); every other row is empty. Each assembled row has the
+    /// bits of the whole assembly's.
+    pub fn assemble_rows(
+        cloud: &Cloud,
+        horizons: &Horizons,
+        weights: &[f64],
+        rows: Range<usize>,
+    ) -> Self {
         let nb = cloud.n_body;
         let targets = &horizons.targets;
         let row = |i: usize| &targets[horizons.row(i)];
-        let lone = lone_bonds(cloud, horizons, weights);
-        let (lone_off, offsets) = row_offsets(horizons, nb, &lone);
+        let lone = lone_bonds(cloud, horizons, weights, &rows);
+        let (lone_off, offsets) = row_offsets(horizons, nb, &rows, &lone);
         let nnz = offsets[nb];
         let mut cols = vec![0 as NodeId; nnz];
         let mut vals = vec![0.0; nnz];
@@ -224,6 +246,9 @@ impl Conductance {
                 let mut e = 0;
                 for (r, d) in ds.iter_mut().enumerate() {
                     let i = first + r;
+                    if !rows.contains(&i) {
+                        continue;
+                    }
                     let out = row(i);
                     let len = out.len();
                     let ow = &weights[horizons.row(i)];

@@ -8,8 +8,12 @@
 //! computes has the same bits as in a serial run, because each row keeps its summation order.
 //! Nothing here talks to other processes; [`crate::solve::exchange`] does.
 
+use crate::cloud::Cloud;
+use crate::kernel::Kernel;
 use crate::math::NodeId;
+use crate::neighbors::Horizons;
 use crate::operator::Conductance;
+use rayon::prelude::*;
 use std::collections::HashSet;
 use std::ops::Range;
 
@@ -30,6 +34,28 @@ impl Partition {
     pub fn by_work(conductance: &Conductance, ranks: usize) -> Self {
         let offsets = &conductance.offsets;
         Self::by_cumulative(offsets.len() - 1, ranks, |i| offsets[i] + ROW_WORK * i)
+    }
+
+    /// Cuts the body rows of `cloud` into `ranks` contiguous ranges of nearly equal estimated
+    /// work, before any bond exists: the pairs of row i taken as the nodes of spacing Δ_i in
+    /// a ball of radius δ_i + Δ_i/2 (exact in the bulk of a lattice; dual-horizon transitions
+    /// and free surfaces differ by a few per cent), plus [`ROW_WORK`]. Every rank computes
+    /// the same cut from the cloud alone.
+    pub fn by_estimate(cloud: &Cloud, ranks: usize) -> Self {
+        let ball = match cloud.dim {
+            1 => 2.0,
+            2 => std::f64::consts::PI,
+            _ => 4.0 / 3.0 * std::f64::consts::PI,
+        };
+        let mut cumulative = Vec::with_capacity(cloud.n_body + 1);
+        cumulative.push(0usize);
+        for i in 0..cloud.n_body {
+            let (d, h) = (cloud.horizon[i], cloud.spacing[i]);
+            let pairs = ball * ((d + 0.5 * h) / h).powi(cloud.dim as i32);
+            let work = pairs.ceil().min(1e9) as usize + ROW_WORK;
+            cumulative.push(cumulative[i] + work);
+        }
+        Self::by_cumulative(cloud.n_body, ranks, |i| cumulative[i])
     }
 
     /// Cuts `rows` rows into `ranks` ranges given the work of rows `0..i` as `work(i)`
@@ -118,6 +144,17 @@ pub fn closure(
     rows: Range<usize>,
     seeds: &[NodeId],
 ) -> Vec<NodeId> {
+    let cols = &conductance.cols[conductance.offsets[rows.start]..conductance.offsets[rows.end]];
+    close(cols.iter().copied(), sources, rows, seeds)
+}
+
+/// [`closure`] of the columns `cols` of the rows `rows`.
+pub fn close(
+    cols: impl Iterator<Item = NodeId>,
+    sources: &[Vec<NodeId>],
+    rows: Range<usize>,
+    seeds: &[NodeId],
+) -> Vec<NodeId> {
     // only the nodes outside the rows are remembered: the work is that of the rows' pairs and
     // the closure, not of the whole cloud (a rank of thousands plans its halo in its share)
     let mut seen: HashSet<NodeId> = HashSet::new();
@@ -127,9 +164,8 @@ pub fn closure(
             stack.push(j);
         }
     };
-    let cols = &conductance.cols[conductance.offsets[rows.start]..conductance.offsets[rows.end]];
-    let own_sources = rows.clone().flat_map(|i| sources[i].iter());
-    for &j in cols.iter().chain(seeds).chain(own_sources) {
+    let own_sources = rows.clone().flat_map(|i| sources[i].iter().copied());
+    for j in cols.chain(seeds.iter().copied()).chain(own_sources) {
         visit(j, &mut stack);
     }
     while let Some(j) = stack.pop() {
@@ -142,61 +178,152 @@ pub fn closure(
     out
 }
 
-/// The halo of every rank of `partition`: who receives which body nodes from whom, and which
-/// rank publishes each node past the body (fictitious nodes) when the ranks gather the whole
-/// field: the first rank that keeps it current; rank 0 takes on the nodes no rank reads, with
-/// their sources. Every rank can compute it alone from the model (no messages at set-up):
-/// one pass over K, O(pairs) in all, plus O(ranks · nodes) to list the results.
+/// The fictitious nodes each rank of `partition` publishes when the ranks gather the whole
+/// field: a node goes to the owner of its anchor, the first body node found by following
+/// the first source of its rule ([`rule_sources`]); nodes set from no body node (a value
+/// given by an expression) go to rank 0. Every rank computes it alone, from the boundary.
+pub fn publishers(
+    sources: &[Vec<NodeId>],
+    n_body: usize,
+    partition: &Partition,
+) -> Vec<Vec<NodeId>> {
+    let mut out = vec![Vec::new(); partition.ranks()];
+    for f in n_body..sources.len() {
+        let owner = anchor(sources, n_body, f).map_or(0, |a| partition.owner(a));
+        out[owner].push(f as NodeId);
+    }
+    out
+}
+
+/// The body node a fictitious node `f` is anchored to ([`publishers`]), if any.
+fn anchor(sources: &[Vec<NodeId>], n_body: usize, f: usize) -> Option<usize> {
+    let mut at = f;
+    // rules chain a few levels at most (a corner set from an edge set from the body)
+    for _ in 0..64 {
+        let s = *sources[at].first()? as usize;
+        if s < n_body {
+            return Some(s);
+        }
+        at = s;
+    }
+    None
+}
+
+/// The halo of rank `rank` without its send lists ([`Halo::recv`] and [`Halo::publish`]):
+/// the [`closure`] of its rows seeded with the fictitious nodes it publishes, its ghosts
+/// grouped by owner. The rows of K it reads are its own, so a rank's share of the model
+/// ([`crate::model::Model::build_share`]) plans its own halo.
+pub fn own_halo(
+    conductance: &Conductance,
+    sources: &[Vec<NodeId>],
+    n_body: usize,
+    partition: &Partition,
+    rank: usize,
+    publish: Vec<NodeId>,
+) -> Halo {
+    let needed = closure(conductance, sources, partition.range(rank), &publish);
+    // sorted ghosts: those of one owner are consecutive (owners hold contiguous rows)
+    let mut recv: Vec<(usize, Vec<NodeId>)> = Vec::new();
+    for g in needed.into_iter().filter(|&g| (g as usize) < n_body) {
+        let owner = partition.owner(g as usize);
+        match recv.last_mut() {
+            Some((o, nodes)) if *o == owner => nodes.push(g),
+            _ => recv.push((owner, vec![g])),
+        }
+    }
+    Halo {
+        recv,
+        send: Vec::new(),
+        publish,
+    }
+}
+
+/// The send lists of every rank from all ranks' receive lists: what r receives from s, s
+/// sends to r.
+pub fn fill_sends(halos: &mut [Halo]) {
+    for r in 0..halos.len() {
+        for (s, nodes) in halos[r].recv.clone() {
+            halos[s].send.push((r, nodes));
+        }
+    }
+    for h in halos.iter_mut() {
+        h.send.sort_by_key(|(r, _)| *r);
+    }
+}
+
+/// The halo of every rank of `partition` from a whole model ([`own_halo`] of each, then
+/// [`fill_sends`]): no messages at set-up.
 pub fn halos(
     conductance: &Conductance,
     sources: &[Vec<NodeId>],
     n_body: usize,
     partition: &Partition,
 ) -> Vec<Halo> {
-    let ranks = partition.ranks();
-    let n = sources.len();
-    let mut closures: Vec<Vec<NodeId>> = (0..ranks)
-        .map(|r| closure(conductance, sources, partition.range(r), &[]))
+    let publish = publishers(sources, n_body, partition);
+    let mut out: Vec<Halo> = publish
+        .into_iter()
+        .enumerate()
+        .map(|(r, p)| own_halo(conductance, sources, n_body, partition, r, p))
         .collect();
-    let mut held = vec![false; n];
-    for c in &closures {
-        for &j in c {
-            held[j as usize] = true;
-        }
-    }
-    let orphans: Vec<NodeId> = (n_body..n)
-        .filter(|&j| !held[j])
-        .map(|j| j as NodeId)
-        .collect();
-    if !orphans.is_empty() && ranks > 0 {
-        closures[0] = closure(conductance, sources, partition.range(0), &orphans);
-    }
-    let mut out = vec![Halo::default(); ranks];
-    let mut published = vec![false; n];
-    for (r, c) in closures.into_iter().enumerate() {
-        // sorted ghosts: those of one owner are consecutive (owners hold contiguous rows)
-        let mut groups: Vec<(usize, Vec<NodeId>)> = Vec::new();
-        for g in c {
-            let gu = g as usize;
-            if gu < n_body {
-                let owner = partition.owner(gu);
-                match groups.last_mut() {
-                    Some((o, nodes)) if *o == owner => nodes.push(g),
-                    _ => groups.push((owner, vec![g])),
-                }
-            } else if !std::mem::replace(&mut published[gu], true) {
-                out[r].publish.push(g);
-            }
-        }
-        for (s, nodes) in groups {
-            out[s].send.push((r, nodes.clone()));
-            out[r].recv.push((s, nodes));
-        }
-    }
-    for h in &mut out {
-        h.send.sort_by_key(|(r, _)| *r);
-    }
+    fill_sends(&mut out);
     out
+}
+
+/// What one rank of a partition would hold and exchange, counted without building the model
+/// ([`loads`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RankLoad {
+    /// Body nodes (rows).
+    pub nodes: usize,
+    /// Pairs of K in its rows.
+    pub pairs: usize,
+    /// Directed bonds of its rows, and from fictitious nodes into them.
+    pub bonds: usize,
+    /// Ghost body nodes it receives per halo exchange.
+    pub ghosts: usize,
+    /// Ranks it receives ghosts from.
+    pub sources: usize,
+    /// Fictitious nodes it publishes at a gather.
+    pub publish: usize,
+}
+
+/// The [`RankLoad`] of every rank of `partition` over `cloud` (bonds by `kernel`, boundary
+/// rules `sources`, [`rule_sources`]): a neighbour search counted per rank
+/// ([`Horizons::census`]), the halo closed as [`own_halo`] closes it.
+pub fn loads(
+    cloud: &Cloud,
+    kernel: &Kernel,
+    sources: &[Vec<NodeId>],
+    partition: &Partition,
+) -> Vec<RankLoad> {
+    let ranges: Vec<Range<usize>> = (0..partition.ranks()).map(|r| partition.range(r)).collect();
+    let census = Horizons::census(cloud, kernel, &ranges);
+    let publish = publishers(sources, cloud.n_body, partition);
+    census
+        .into_par_iter()
+        .zip(publish)
+        .enumerate()
+        .map(|(r, (c, publish))| {
+            let needed = close(c.outside.into_iter(), sources, partition.range(r), &publish);
+            let ghosts: Vec<NodeId> = needed
+                .into_iter()
+                .filter(|&g| (g as usize) < cloud.n_body)
+                .collect();
+            let mut owners: Vec<usize> = ghosts
+                .iter()
+                .map(|&g| partition.owner(g as usize))
+                .collect();
+            owners.dedup();
+            RankLoad {
+                nodes: partition.range(r).len(),
+                pairs: c.pairs,
+                bonds: c.bonds,
+                ghosts: ghosts.len(),
+                sources: owners.len(),
+                publish: publish.len(),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -273,8 +400,8 @@ mod tests {
 
     #[test]
     fn each_fictitious_node_is_published_once() {
-        // nodes 0..6 body, 6 and 7 fictitious: 6 is read by row 0 and set from node 1; 7 is
-        // read by no row and set from node 5, so rank 0 keeps it (and node 5) current
+        // nodes 0..6 body, 6 and 7 fictitious: 6 is read by row 0 and set from node 1, so
+        // rank 0 publishes it; 7 is read by no row and set from node 5, so rank 1 does
         let mut k = chain(6);
         k.cols.insert(0, 6);
         k.vals.insert(0, 1.0);
@@ -290,8 +417,15 @@ mod tests {
         let h = halos(&k, &rules, 6, &p);
         assert_eq!(
             (h[0].publish.clone(), h[1].publish.clone()),
-            (vec![6, 7], vec![])
+            (vec![6], vec![7])
         );
-        assert_eq!(h[0].recv, vec![(1, vec![3, 5])]);
+        assert_eq!(h[0].recv, vec![(1, vec![3])]);
+        // a node set from another fictitious node follows it to its body anchor; one set
+        // from none (an expression) goes to rank 0
+        let mut rules = vec![Vec::new(); 9];
+        rules[6] = vec![7];
+        rules[7] = vec![5];
+        let p = publishers(&rules, 6, &p);
+        assert_eq!(p, vec![vec![8], vec![6, 7]]);
     }
 }

@@ -437,6 +437,13 @@ pub struct Ranks {
     pub ghosts: Vec<usize>,
     /// Pairs of K in each rank's rows.
     pub pairs: Vec<usize>,
+    /// Directed bonds of each rank's rows, and from fictitious nodes into them.
+    #[serde(default)]
+    pub bonds: Vec<usize>,
+    /// `share` (each rank built the bonds of its rows alone) or `whole` (every rank built the
+    /// whole model: consistent weights, cracks, phase change, implicit and adaptive steps).
+    #[serde(default)]
+    pub setup: String,
     /// Bytes all ranks receive per halo exchange (an Euler step has one, RK4 four), B.
     pub halo_bytes: usize,
     /// Longest time any rank spent in halo exchanges, s.

@@ -11,9 +11,12 @@ use crate::math::NodeId;
 use crate::partition::{Halo, Partition};
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Barrier};
+use std::sync::{Arc, Barrier, Mutex};
 
-/// How [`Exchange::reduce`] combines the ranks' values.
+/// Node lists by rank, `(rank, nodes)`: what a rank receives from or sends to each other.
+pub type NodeLists = Vec<(usize, Vec<NodeId>)>;
+
+/// How [`Collective::reduce`] combines the ranks' values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reduce {
     /// The sum (in rank order).
@@ -35,19 +38,28 @@ impl Reduce {
     }
 }
 
-/// The communication of one rank of a distributed run. Every method is collective: all
-/// ranks call it, in the same order, from the thread that steps.
-pub trait Exchange: Sync {
+/// The messages of a distributed run that need no halo: reductions, and the lists the
+/// ranks swap while they plan their halos ([`RankPlan::of_share`]). Every method is
+/// collective: all ranks call it, in the same order, from the thread that steps.
+pub trait Collective: Sync {
+    /// This rank, from 0.
+    fn rank(&self) -> usize;
+    /// Number of ranks.
+    fn size(&self) -> usize;
+    /// `x` combined over the ranks by `op`, the same on every rank.
+    fn reduce(&self, x: f64, op: Reduce) -> f64;
+    /// Sends each `(rank, nodes)` of `lists` to that rank (at most one list per rank) and
+    /// returns the lists the other ranks sent this one, as `(sender, nodes)` by sender.
+    fn swap(&self, lists: &NodeLists) -> NodeLists;
+    /// `x` of every rank, in rank order.
+    fn gather_counts(&self, x: u64) -> Vec<u64>;
+}
+
+/// The communication of one rank of a distributed run once its halo is planned: ghost
+/// temperatures, whole fields at outputs, and the [`Collective`] messages.
+pub trait Exchange: Collective {
     /// This rank's rows and halo, and every rank's rows.
     fn plan(&self) -> &RankPlan;
-    /// This rank, from 0.
-    fn rank(&self) -> usize {
-        self.plan().rank
-    }
-    /// Number of ranks.
-    fn size(&self) -> usize {
-        self.plan().partition.ranks()
-    }
     /// The body rows this rank owns.
     fn rows(&self) -> Range<usize> {
         self.plan().partition.range(self.plan().rank)
@@ -59,8 +71,6 @@ pub trait Exchange: Sync {
     /// its owner holds (body nodes) or its publisher (fictitious nodes,
     /// [`crate::partition::Halo::publish`]).
     fn all_gather(&self, field: &mut [f64]);
-    /// `x` combined over the ranks by `op`, the same on every rank.
-    fn reduce(&self, x: f64, op: Reduce) -> f64;
     /// Time spent in [`Exchange::halo`] so far on this rank, s.
     fn exchange_seconds(&self) -> f64;
 }
@@ -76,11 +86,18 @@ pub struct RankPlan {
     pub halo: Halo,
 }
 
-/// [`Exchange`] between threads of one process: rank r of `n` in-process ranks. The owners
-/// publish their rows in a shared array and the readers copy from it between barriers.
-pub struct InProcess {
-    plan: RankPlan,
+/// [`Collective`] between threads of one process: rank r of `n` in-process ranks, before
+/// their halos are planned ([`InProcessLink::with_plan`] makes it an [`InProcess`]).
+pub struct InProcessLink {
+    rank: usize,
     shared: Arc<Shared>,
+}
+
+/// [`Exchange`] between threads of one process, for tests and for machines without MPI. The
+/// owners publish their rows in a shared array and the readers copy from it between barriers.
+pub struct InProcess {
+    link: InProcessLink,
+    plan: RankPlan,
 }
 
 /// The state the in-process ranks share.
@@ -90,40 +107,120 @@ struct Shared {
     field: Vec<AtomicU64>,
     /// One slot per rank for reductions.
     slots: Vec<AtomicU64>,
+    /// The lists sent to each rank by [`Collective::swap`], as `(sender, nodes)`.
+    mail: Mutex<Vec<NodeLists>>,
+}
+
+impl InProcessLink {
+    /// One link per rank of `ranks` over `n_nodes` nodes (body and fictitious), to be moved
+    /// into one thread each.
+    pub fn group(ranks: usize, n_nodes: usize) -> Vec<InProcessLink> {
+        let shared = Arc::new(Shared {
+            barrier: Barrier::new(ranks),
+            field: (0..n_nodes).map(|_| AtomicU64::new(0)).collect(),
+            slots: (0..ranks).map(|_| AtomicU64::new(0)).collect(),
+            mail: Mutex::new(vec![Vec::new(); ranks]),
+        });
+        (0..ranks)
+            .map(|rank| InProcessLink {
+                rank,
+                shared: shared.clone(),
+            })
+            .collect()
+    }
+
+    /// This link with its rank's plan: an [`Exchange`].
+    pub fn with_plan(self, plan: RankPlan) -> InProcess {
+        InProcess { link: self, plan }
+    }
+}
+
+impl Collective for InProcessLink {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.shared.slots.len()
+    }
+    fn reduce(&self, x: f64, op: Reduce) -> f64 {
+        let all = self.gather_counts(x.to_bits());
+        let load = |r: usize| f64::from_bits(all[r]);
+        (1..all.len()).fold(load(0), |a, r| op.apply(a, load(r)))
+    }
+    fn swap(&self, lists: &NodeLists) -> NodeLists {
+        {
+            let mut mail = self.shared.mail.lock().expect("mail");
+            for (to, nodes) in lists {
+                mail[*to].push((self.rank, nodes.clone()));
+            }
+        }
+        self.shared.barrier.wait();
+        let mut got = std::mem::take(&mut self.shared.mail.lock().expect("mail")[self.rank]);
+        got.sort_by_key(|(from, _)| *from);
+        // nobody sends again before everyone has taken theirs
+        self.shared.barrier.wait();
+        got
+    }
+    fn gather_counts(&self, x: u64) -> Vec<u64> {
+        self.shared.slots[self.rank].store(x, Ordering::Relaxed);
+        self.shared.barrier.wait();
+        let all = self
+            .shared
+            .slots
+            .iter()
+            .map(|s| s.load(Ordering::Relaxed))
+            .collect();
+        self.shared.barrier.wait();
+        all
+    }
 }
 
 impl InProcess {
     /// One [`InProcess`] per rank of `plans` (all of the same partition) over `n_nodes` nodes
     /// (body and fictitious), to be moved into one thread each.
     pub fn group(plans: Vec<RankPlan>, n_nodes: usize) -> Vec<InProcess> {
-        let shared = Arc::new(Shared {
-            barrier: Barrier::new(plans.len()),
-            field: (0..n_nodes).map(|_| AtomicU64::new(0)).collect(),
-            slots: (0..plans.len()).map(|_| AtomicU64::new(0)).collect(),
-        });
-        plans
+        let links = InProcessLink::group(plans.len(), n_nodes);
+        links
             .into_iter()
-            .map(|plan| InProcess {
-                plan,
-                shared: shared.clone(),
-            })
+            .zip(plans)
+            .map(|(l, p)| l.with_plan(p))
             .collect()
     }
 
     /// Publishes the entries `nodes` of `field` this rank holds current.
     fn publish(&self, field: &[f64], nodes: impl Iterator<Item = usize>) {
+        let shared = &self.link.shared;
         for i in nodes {
-            self.shared.field[i].store(field[i].to_bits(), Ordering::Relaxed);
+            shared.field[i].store(field[i].to_bits(), Ordering::Relaxed);
         }
-        self.shared.barrier.wait();
+        shared.barrier.wait();
     }
 
     fn read(&self, field: &mut [f64], nodes: impl Iterator<Item = usize>) {
+        let shared = &self.link.shared;
         for j in nodes {
-            field[j] = f64::from_bits(self.shared.field[j].load(Ordering::Relaxed));
+            field[j] = f64::from_bits(shared.field[j].load(Ordering::Relaxed));
         }
         // nobody publishes again before everyone has read
-        self.shared.barrier.wait();
+        shared.barrier.wait();
+    }
+}
+
+impl Collective for InProcess {
+    fn rank(&self) -> usize {
+        self.link.rank()
+    }
+    fn size(&self) -> usize {
+        self.link.size()
+    }
+    fn reduce(&self, x: f64, op: Reduce) -> f64 {
+        self.link.reduce(x, op)
+    }
+    fn swap(&self, lists: &NodeLists) -> NodeLists {
+        self.link.swap(lists)
+    }
+    fn gather_counts(&self, x: u64) -> Vec<u64> {
+        self.link.gather_counts(x)
     }
 }
 
@@ -139,15 +236,7 @@ impl Exchange for InProcess {
     fn all_gather(&self, field: &mut [f64]) {
         self.publish(field, self.plan.gathered());
         // every node has exactly one publisher (its own entries come back unchanged)
-        self.read(field, 0..self.shared.field.len());
-    }
-    fn reduce(&self, x: f64, op: Reduce) -> f64 {
-        self.shared.slots[self.rank()].store(x.to_bits(), Ordering::Relaxed);
-        self.shared.barrier.wait();
-        let load = |r: usize| f64::from_bits(self.shared.slots[r].load(Ordering::Relaxed));
-        let v = (1..self.size()).fold(load(0), |a, r| op.apply(a, load(r)));
-        self.shared.barrier.wait();
-        v
+        self.read(field, 0..self.link.shared.field.len());
     }
     fn exchange_seconds(&self) -> f64 {
         0.0
@@ -155,14 +244,13 @@ impl Exchange for InProcess {
 }
 
 impl RankPlan {
-    /// The plans of all `ranks` ranks of `model`: rows cut by work ([`Partition::by_work`]),
-    /// halos closed under the boundary's rules ([`crate::partition::halos`]).
+    /// The plans of all `ranks` ranks of a whole `model`: rows cut by estimated work
+    /// ([`Partition::by_estimate`]), halos closed under the boundary's rules
+    /// ([`crate::partition::halos`]); no messages.
     pub fn all(model: &crate::model::Model, ranks: usize) -> Vec<RankPlan> {
-        let k = &model.conductance;
-        let partition = Partition::by_work(k, ranks);
-        let rules = model.boundary.linear_rules();
-        let sources = crate::partition::rule_sources(model.cloud.len(), &rules);
-        crate::partition::halos(k, &sources, model.cloud.n_body, &partition)
+        let partition = Partition::by_estimate(&model.cloud, ranks);
+        let sources = rule_sources_of(model);
+        crate::partition::halos(&model.conductance, &sources, model.cloud.n_body, &partition)
             .into_iter()
             .enumerate()
             .map(|(rank, halo)| RankPlan {
@@ -173,10 +261,45 @@ impl RankPlan {
             .collect()
     }
 
+    /// The plan of this rank from its share of the model ([`crate::model::Model::build_share`]
+    /// over `partition`): its own halo, and what it sends, swapped with the others. The same
+    /// plan as [`RankPlan::all`] gives this rank.
+    pub fn of_share(
+        model: &crate::model::Model,
+        partition: Partition,
+        link: &dyn Collective,
+    ) -> RankPlan {
+        let rank = link.rank();
+        let sources = rule_sources_of(model);
+        let nb = model.cloud.n_body;
+        let publish = crate::partition::publishers(&sources, nb, &partition).swap_remove(rank);
+        let k = &model.conductance;
+        let mut halo = crate::partition::own_halo(k, &sources, nb, &partition, rank, publish);
+        halo.send = link.swap(&halo.recv);
+        RankPlan {
+            rank,
+            partition,
+            halo,
+        }
+    }
+
     /// The nodes this rank gives the others when the whole field is gathered: its rows, then
     /// the fictitious nodes it publishes ([`Halo::publish`]).
     pub fn gathered(&self) -> impl Iterator<Item = usize> + '_ {
         let publish = self.halo.publish.iter().map(|&j| j as usize);
         self.partition.range(self.rank).chain(publish)
     }
+}
+
+/// The fictitious nodes each rank of `partition` publishes at a gather, by rank
+/// ([`crate::partition::publishers`]).
+pub fn publishers_of(model: &crate::model::Model, partition: &Partition) -> Vec<Vec<NodeId>> {
+    let sources = rule_sources_of(model);
+    crate::partition::publishers(&sources, model.cloud.n_body, partition)
+}
+
+/// The sources of each node's boundary rule ([`crate::partition::rule_sources`]).
+fn rule_sources_of(model: &crate::model::Model) -> Vec<Vec<NodeId>> {
+    let rules = model.boundary.linear_rules();
+    crate::partition::rule_sources(model.cloud.len(), &rules)
 }
