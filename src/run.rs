@@ -10,7 +10,10 @@ use crate::model::crack_cutters;
 use crate::model::Model;
 use crate::operator::Conductance;
 use crate::output::read_field;
-use crate::output::{field_csv, field_path, field_vtu, vtu_path, Fields, Ranks, RunSummary};
+use crate::output::{
+    field_csv, field_path, field_pvtu, field_vtu, field_vtu_rows, piece_path, pvd_path, pvtu_path,
+    series_pvd, vtu_path, Fields, Ranks, RunSummary,
+};
 use crate::prepare::{keyed, likely_cause, plan, Options, Plan};
 use crate::reference::{ReferenceTable, Snapshot};
 use crate::report::{classical_at, compare};
@@ -102,17 +105,20 @@ pub fn run_ranked<'a>(
     done.map(Some)
 }
 
-/// The heat flux of every body node at an output (W/m²): a share computes its own rows and
-/// the ranks gather them (a collective then); a whole model computes them all.
-fn output_flux(
+/// The heat flux (W/m²) and damage of every body node at output time `t` (s): a share
+/// computes its own rows and the ranks gather them (a collective then); a whole model
+/// computes them all.
+fn output_fields(
     model: &Model,
+    t: f64,
     theta: &[f64],
     conductance: &Conductance,
     exchange: Option<&dyn Exchange>,
-) -> Vec<crate::math::Vector> {
+) -> (Vec<crate::math::Vector>, Vec<f64>) {
     let mut flux = conductance.flux(&model.cloud, theta);
+    let mut damage = model.damage_at(t);
     let Some(ex) = exchange.filter(|_| model.rows != (0..model.cloud.n_body)) else {
-        return flux;
+        return (flux, damage);
     };
     let mut part = vec![0.0; model.cloud.len()];
     for axis in 0..3 {
@@ -124,7 +130,11 @@ fn output_flux(
             q[axis] = *p;
         }
     }
-    flux
+    let n = damage.len();
+    part[..n].copy_from_slice(&damage);
+    ex.all_gather(&mut part);
+    damage.copy_from_slice(&part[..n]);
+    (flux, damage)
 }
 
 /// True on every rank when `ok` on all ranks (a collective, [`Exchange::reduce`]); a
@@ -154,9 +164,9 @@ fn follow(case: &Case, model: &Model, plan: Plan, rank: &Rank) -> Result<()> {
         &mut theta,
         0.0,
         &times,
-        |k, _, th, conductance, _| {
+        |k, t, th, conductance, _| {
             if output_index(&case.outputs, times[k]).is_some() {
-                output_flux(model, th, conductance, Some(exchange));
+                output_fields(model, t, th, conductance, Some(exchange));
             }
             peer(agree(Some(exchange), true))
         },
@@ -222,6 +232,10 @@ fn execute(
         return Err(ready.err().unwrap_or(Error::Peer));
     }
     let (origin, mut writer) = ready?;
+    if let Some(ex) = ex.filter(|ex| ex.size() > 1) {
+        let p = &ex.plan().partition;
+        writer.pieces = (0..p.ranks()).map(|r| p.range(r)).collect();
+    }
     let fem_seconds = t_run.elapsed().as_secs_f64();
     let reference = writer.reference.clone();
     // the steppers stop at the outputs and at the history's samples
@@ -235,8 +249,8 @@ fn execute(
         }
         let written = match output_index(&case.outputs, times[k]) {
             Some(f) => {
-                let flux = output_flux(model, th, conductance, ex);
-                writer.write_with_flux(f, t, th, &flux, e)
+                let (flux, damage) = output_fields(model, t, th, conductance, ex);
+                writer.write_fields(f, t, th, (&flux, &damage), e)
             }
             None => Ok(()),
         };
@@ -391,6 +405,11 @@ pub struct OutputWriter<'a> {
     pub comparisons: Vec<crate::output::Comparison>,
     /// Time spent evaluating and comparing with the reference, s.
     pub reference_seconds: f64,
+    /// The body rows of each rank of a distributed run (empty: a serial run), one piece each
+    /// of the parallel VTK files.
+    pub pieces: Vec<std::ops::Range<usize>>,
+    /// `(time, VTK file)` of each output written, for `fields.pvd`.
+    series: Vec<(f64, String)>,
 }
 
 impl<'a> OutputWriter<'a> {
@@ -406,6 +425,8 @@ impl<'a> OutputWriter<'a> {
             fields: Vec::new(),
             comparisons: Vec::new(),
             reference_seconds: 0.0,
+            pieces: Vec::new(),
+            series: Vec::new(),
         })
     }
 
@@ -432,10 +453,24 @@ impl<'a> OutputWriter<'a> {
         flux: &[crate::math::Vector],
         e: f64,
     ) -> Result<()> {
+        let damage = self.model.damage_at(t);
+        self.write_fields(k, t, th, (flux, &damage), e)
+    }
+
+    /// [`OutputWriter::write_with_flux`] with the damage of every body node given too
+    /// (`nodal`: flux, W/m², and damage).
+    pub fn write_fields(
+        &mut self,
+        k: usize,
+        t: f64,
+        th: &[f64],
+        nodal: (&[crate::math::Vector], &[f64]),
+        e: f64,
+    ) -> Result<()> {
         let (case, model, out) = (self.case, self.model, self.out);
+        let (flux, damage) = nodal;
         self.energy.push(e);
         let path = field_path(out, k + 1);
-        let damage = model.damage_at(t);
         let classical = match &self.reference {
             Some(r) => {
                 let started = Instant::now();
@@ -461,15 +496,14 @@ impl<'a> OutputWriter<'a> {
         };
         let f = Fields {
             theta: th,
-            damage: &damage,
+            damage,
             flux,
             reference: classical.as_deref(),
         };
         write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
-        write_atomic(
-            &vtu_path(out, k + 1),
-            field_vtu(&model.cloud, &f).as_bytes(),
-        )?;
+        let vtk = self.write_vtk(k + 1, &f)?;
+        self.series.push((t, vtk));
+        write_atomic(&pvd_path(out), series_pvd(&self.series).as_bytes())?;
         self.fields.push(
             path.file_name()
                 .expect("file")
@@ -477,6 +511,33 @@ impl<'a> OutputWriter<'a> {
                 .into_owned(),
         );
         Ok(())
+    }
+}
+
+impl OutputWriter<'_> {
+    /// Writes the VTK file of output `k` (from 1): `field_<k>.vtu`, or for a distributed run
+    /// one piece per rank and `field_<k>.pvtu` over them; its name.
+    fn write_vtk(&self, k: usize, f: &Fields) -> Result<String> {
+        let (cloud, out) = (&self.model.cloud, self.out);
+        if self.pieces.is_empty() {
+            write_atomic(&vtu_path(out, k), field_vtu(cloud, f).as_bytes())?;
+            return Ok(format!("field_{k}.vtu"));
+        }
+        let dir = piece_path(out, k, 0);
+        let dir = dir.parent().expect("a piece's directory");
+        std::fs::create_dir_all(dir).map_err(|error| Error::Io {
+            path: dir.to_path_buf(),
+            error,
+        })?;
+        let mut names = Vec::with_capacity(self.pieces.len());
+        for (r, rows) in self.pieces.iter().enumerate() {
+            let piece = field_vtu_rows(cloud, f, rows.clone());
+            write_atomic(&piece_path(out, k, r), piece.as_bytes())?;
+            names.push(format!("field_{k}/piece_{r}.vtu"));
+        }
+        let pvtu = field_pvtu(&names, f.reference.is_some());
+        write_atomic(&pvtu_path(out, k), pvtu.as_bytes())?;
+        Ok(format!("field_{k}.pvtu"))
     }
 }
 

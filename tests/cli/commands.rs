@@ -95,6 +95,10 @@ fn run_honours_the_output_contract() {
             );
         }
     }
+    // and their time series for ParaView
+    let pvd = std::fs::read_to_string(out.join("fields.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet timestep=").count(), 2, "{pvd}");
+    assert!(pvd.contains("file=\"field_2.vtu\""), "{pvd}");
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .filter(|e| {

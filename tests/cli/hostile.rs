@@ -187,6 +187,7 @@ fn output_directories_are_transactional() {
         "field_1.vtu",
         "field_2.csv",
         "field_2.vtu",
+        "fields.pvd",
         "run.json",
     ];
     assert_eq!(entries(&out), want, "stale files after a shorter rerun");

@@ -159,3 +159,55 @@ fn a_bad_case_fails_once_on_every_rank_and_writes_nothing() {
     assert!(lines[0].contains("bad.toml"), "{err}");
     assert!(!out.exists(), "no output directory");
 }
+
+/// ParaView's data, as VTK's Python reader sees it: a 3-rank run's `fields.pvd` lists one
+/// `.pvtu` per output, each opens as one dataset with every body node once, and its positions
+/// and temperatures are those of the CSV (tests/mpi/read_pvd.py). Needs VTK's Python package
+/// (`pip install vtk numpy`, which .ci/run does in its virtual environment).
+#[test]
+fn paraview_reads_a_three_rank_run_as_one_dataset() {
+    let python = std::env::var("PERITHERM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let has_vtk = std::process::Command::new(&python)
+        .args(["-c", "import vtk, numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    assert!(
+        has_vtk,
+        "{python} has no VTK: pip install vtk numpy (README: Contributing), or set PERITHERM_PYTHON"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/crack_plate_uniform.toml");
+    let o = mpiexec(
+        3,
+        &[
+            "run",
+            case.to_str().unwrap(),
+            "--set",
+            "time.end=0.001",
+            "--set",
+            "time.outputs=[0.0005,0.001]",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/mpi/read_pvd.py");
+    let o = std::process::Command::new(&python)
+        .arg(&script)
+        .arg(&out)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{said}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(said.lines().count(), 2, "{said}");
+    assert!(
+        said.contains("field_2.pvtu: t = 0.001 s, 59732 nodes"),
+        "{said}"
+    );
+}

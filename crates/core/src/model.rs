@@ -493,9 +493,10 @@ impl Model {
     }
 
     /// Whether a spec can be built one rank's share at a time ([`Model::build_share`]): every
-    /// row of K depends on its own neighbourhood only. Not so for the consistent weights (one
-    /// global solve), cracks (damage and growth read every row), nodal flux relations (their
-    /// micro-conductances) and phase change (its stepper is not distributed).
+    /// row of K depends on its own neighbourhood only (cracks too: their cuts, the restored
+    /// moment and the damage are per row). Not so for the consistent weights (one global
+    /// solve), nodal flux relations (their micro-conductances) and phase change (its stepper
+    /// is not distributed).
     pub fn shareable(spec: &ModelSpec) -> bool {
         let corrected = spec.consistency != Order::None && !spec.symmetry.is_symmetric();
         let relation = spec
@@ -503,7 +504,7 @@ impl Model {
             .iter()
             .any(|f| matches!(f, FaceBc::RelationFlux { .. }));
         let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
-        !(corrected || relation || phase || !spec.cracks.is_empty())
+        !(corrected || relation || phase)
     }
 
     /// The share of rank `rank` of `ranks` of a [`Model::shareable`] spec, and the partition

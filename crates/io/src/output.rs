@@ -2,7 +2,9 @@
 //!
 //! Contract: for the k-th output time (k from 1), `field_<k>.csv` with the columns
 //! `x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz`, one row per body
-//! node, and the same fields as a VTK unstructured grid `field_<k>.vtu`; and `run.json`.
+//! node, and the same fields as a VTK unstructured grid `field_<k>.vtu` (a distributed run:
+//! `field_<k>.pvtu` over one piece per rank, `field_<k>/piece_<r>.vtu`), all listed with their
+//! times in `fields.pvd`; and `run.json`.
 //! A case with a `[history]` also writes `history.csv` ([`crate::history`]); every run
 //! (also one that fails or is interrupted) writes `case.toml`, the text of its case
 //! ([`crate::provenance`]).
@@ -13,6 +15,7 @@ use peritherm_core::error::{Error, Result};
 use peritherm_core::math::{Point, Vector};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 /// A time (s) or coordinate (m) as tables, legends and file names show it: plainly (`0.5`,
@@ -124,56 +127,60 @@ fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
 /// flux, damage, the classical reference (if any), horizon, spacing, volume and region, for
 /// ParaView.
 pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
-    let n = cloud.n_body;
+    field_vtu_rows(cloud, f, 0..cloud.n_body)
+}
+
+/// The point arrays of a field's VTK files, in their order: (VTK type, name, components).
+fn point_arrays(reference: bool) -> Vec<(&'static str, &'static str, usize)> {
+    let mut a = vec![
+        ("Float64", "temperature", 1),
+        ("Float64", "flux", 3),
+        ("Float64", "damage", 1),
+    ];
+    if reference {
+        a.push(("Float64", "reference", 1));
+    }
+    a.extend([
+        ("Float64", "horizon", 1),
+        ("Float64", "spacing", 1),
+        ("Float64", "volume", 1),
+        ("Int32", "region", 1),
+    ]);
+    a
+}
+
+/// The bytes of point array `name` ([`point_arrays`]) over the body nodes `rows`.
+fn point_bytes(cloud: &Cloud, f: &Fields, name: &str, rows: Range<usize>) -> Vec<u8> {
+    let scalar = |v: &[f64]| f64_bytes(v[rows.clone()].iter().copied());
+    match name {
+        "temperature" => scalar(f.theta),
+        "flux" => f64_bytes(f.flux[rows].iter().flat_map(|q| [q.x, q.y, q.z])),
+        "damage" => scalar(f.damage),
+        "reference" => f.reference.map(scalar).unwrap_or_default(),
+        "horizon" => scalar(&cloud.horizon),
+        "spacing" => scalar(&cloud.spacing),
+        "volume" => scalar(&cloud.volume),
+        _ => cloud.region[rows]
+            .iter()
+            .flat_map(|r| (*r as i32).to_le_bytes())
+            .collect(),
+    }
+}
+
+/// [`field_vtu`] of the body nodes `rows` alone: one piece of a parallel file
+/// ([`field_pvtu`]).
+pub fn field_vtu_rows(cloud: &Cloud, f: &Fields, rows: Range<usize>) -> String {
+    let n = rows.len();
     let mut s = String::with_capacity(n * 140);
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n");
     let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">");
     s.push_str("<PointData Scalars=\"temperature\" Vectors=\"flux\">\n");
-    vtk_array(
-        &mut s,
-        "Float64",
-        "temperature",
-        1,
-        &f64_bytes(f.theta[..n].iter().copied()),
-    );
-    let flux = f.flux.iter().flat_map(|q| [q.x, q.y, q.z]);
-    vtk_array(&mut s, "Float64", "flux", 3, &f64_bytes(flux));
-    vtk_array(
-        &mut s,
-        "Float64",
-        "damage",
-        1,
-        &f64_bytes(f.damage.iter().copied()),
-    );
-    if let Some(r) = f.reference {
-        vtk_array(
-            &mut s,
-            "Float64",
-            "reference",
-            1,
-            &f64_bytes(r.iter().copied()),
-        );
+    for (kind, name, comps) in point_arrays(f.reference.is_some()) {
+        let bytes = point_bytes(cloud, f, name, rows.clone());
+        vtk_array(&mut s, kind, name, comps, &bytes);
     }
-    for (name, v) in [
-        ("horizon", &cloud.horizon),
-        ("spacing", &cloud.spacing),
-        ("volume", &cloud.volume),
-    ] {
-        vtk_array(
-            &mut s,
-            "Float64",
-            name,
-            1,
-            &f64_bytes(v[..n].iter().copied()),
-        );
-    }
-    let region: Vec<u8> = cloud.region[..n]
-        .iter()
-        .flat_map(|r| (*r as i32).to_le_bytes())
-        .collect();
-    vtk_array(&mut s, "Int32", "region", 1, &region);
     s.push_str("</PointData>\n<Points>\n");
-    let pos = cloud.pos[..n].iter().flat_map(|p| [p.x, p.y, p.z]);
+    let pos = cloud.pos[rows].iter().flat_map(|p| [p.x, p.y, p.z]);
     vtk_array(&mut s, "Float64", "Points", 3, &f64_bytes(pos));
     s.push_str("</Points>\n<Cells>\n");
     let ids: Vec<u8> = (0..n as i64).flat_map(i64::to_le_bytes).collect();
@@ -182,6 +189,54 @@ pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
     vtk_array(&mut s, "Int64", "offsets", 1, &offsets);
     vtk_array(&mut s, "UInt8", "types", 1, &vec![1u8; n]); // VTK_VERTEX
     s.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    s
+}
+
+/// Path of the k-th parallel VTK file (k from 1): `field_<k>.pvtu`, whose pieces are
+/// [`piece_path`].
+pub fn pvtu_path(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("field_{k}.pvtu"))
+}
+
+/// Path of piece `r` (rank r's rows) of the k-th parallel VTK file: `field_<k>/piece_<r>.vtu`.
+pub fn piece_path(dir: &Path, k: usize, r: usize) -> PathBuf {
+    dir.join(format!("field_{k}"))
+        .join(format!("piece_{r}.vtu"))
+}
+
+/// A parallel VTK unstructured grid (`.pvtu`) over `pieces` (paths relative to it, written by
+/// [`field_vtu_rows`]), with the point arrays of a field with or without a reference.
+pub fn field_pvtu(pieces: &[String], reference: bool) -> String {
+    let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData Scalars=\"temperature\" Vectors=\"flux\">\n");
+    for (kind, name, comps) in point_arrays(reference) {
+        let _ = writeln!(
+            s,
+            "<PDataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\"/>"
+        );
+    }
+    s.push_str("</PPointData>\n<PPoints>\n<PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n</PPoints>\n");
+    for p in pieces {
+        let _ = writeln!(s, "<Piece Source=\"{p}\"/>");
+    }
+    s.push_str("</PUnstructuredGrid>\n</VTKFile>\n");
+    s
+}
+
+/// Path of the time series of a run's VTK files: `fields.pvd`.
+pub fn pvd_path(dir: &Path) -> PathBuf {
+    dir.join("fields.pvd")
+}
+
+/// A ParaView time series (`.pvd`) of `(time in s, file relative to it)`, in order.
+pub fn series_pvd(entries: &[(f64, String)]) -> String {
+    let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
+    for (t, file) in entries {
+        let _ = writeln!(
+            s,
+            "<DataSet timestep=\"{t:e}\" part=\"0\" file=\"{file}\"/>"
+        );
+    }
+    s.push_str("</Collection>\n</VTKFile>\n");
     s
 }
 

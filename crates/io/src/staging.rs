@@ -39,6 +39,7 @@ fn is_ours(name: &str) -> bool {
         || name == crate::provenance::CASE_COPY
         || name == crate::history::FILE
         || name == "fem"
+        || name == "fields.pvd"
         || name.starts_with('.')
         || ["field_", "map_", "damage_", "flux_"]
             .iter()
