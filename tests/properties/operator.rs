@@ -433,6 +433,42 @@ fn neighbour_search_grid_equals_tree() {
     assert_eq!(a.targets, model.horizons.targets);
 }
 
+/// A rank's rows searched alone ([`Horizons::build_rows_with`], grid and k-d tree, 1 to 4
+/// ranks) are the whole search's rows, and so is every row whose horizon holds one of them
+/// (the margin the assembly reads: dual horizon, fictitious layers).
+#[test]
+fn a_ranks_search_holds_its_rows_and_their_margin() {
+    use peritherm::neighbors::Horizons;
+    use peritherm::partition::Partition;
+    let model = refined_dual_horizon(MIRROR_FACES);
+    let kernel = dual_horizon_case("", "lattice").spec.kernel;
+    let whole = &model.horizons;
+    let row = |h: &Horizons, i: usize| h.targets[h.row(i)].to_vec();
+    for grid in [true, false] {
+        for ranks in 1..=4 {
+            let partition = Partition::by_estimate(&model.cloud, ranks);
+            for r in 0..ranks {
+                let rows = partition.range(r);
+                let h = Horizons::build_rows_with(&model.cloud, &kernel, rows.clone(), grid);
+                let mut needed: Vec<usize> = rows.clone().collect();
+                for j in 0..whole.len() {
+                    let t = &whole.targets[whole.row(j)];
+                    if t.iter().any(|&i| rows.contains(&(i as usize))) {
+                        needed.push(j);
+                    }
+                }
+                for i in needed {
+                    assert_eq!(
+                        row(&h, i),
+                        row(whole, i),
+                        "grid {grid}, {ranks} ranks, row {i}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// The Gershgorin bound of theory §4 is safe and not far from the truth: Euler at the
 /// bound stays bounded; Euler at 1.2× the true limit 2/λ_max (power iteration) blows up;
 /// a user Δt above the bound is refused with the bound in the message.

@@ -89,6 +89,39 @@ impl Grid {
         Some(g)
     }
 
+    /// Marks the rows `rows` and every node in a cell within `rmax` of a cell holding one of
+    /// them: a superset of the nodes within `rmax` of the rows, found cell by cell (no
+    /// distance is computed).
+    fn near(&self, pts: &[[f64; 3]], rows: std::ops::Range<usize>, rmax: f64) -> Vec<bool> {
+        let ncell = self.dims[0] * self.dims[1] * self.dims[2];
+        let mut held = vec![false; ncell];
+        for p in &pts[rows.clone()] {
+            held[self.cell_of(p)] = true;
+        }
+        // cells within rmax of a held one: k cells each way (the cells are rmax/2 wide)
+        let k = (rmax * self.inv).ceil() as usize + 1;
+        let mut near = vec![false; ncell];
+        let [dx, dy, dz] = self.dims;
+        for c in (0..ncell).filter(|&c| held[c]) {
+            let (x, y, z) = (c % dx, (c / dx) % dy, c / (dx * dy));
+            let span = |v: usize, d: usize| v.saturating_sub(k)..=(v + k).min(d - 1);
+            for zz in span(z, dz) {
+                for yy in span(y, dy) {
+                    let row = (zz * dy + yy) * dx;
+                    near[row + x.saturating_sub(k)..=row + (x + k).min(dx - 1)].fill(true);
+                }
+            }
+        }
+        let mut wanted = vec![false; pts.len()];
+        wanted[rows].fill(true);
+        for c in (0..ncell).filter(|&c| near[c]) {
+            for &j in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                wanted[j as usize] = true;
+            }
+        }
+        wanted
+    }
+
     fn coord(&self, x: f64, a: usize) -> usize {
         (((x - self.lo[a]) * self.inv).floor().max(0.0) as usize).min(self.dims[a] - 1)
     }
@@ -347,10 +380,23 @@ impl Horizons {
 
     /// The rows a rank needs to assemble the body rows `rows` of K bit for bit as a whole
     /// model would (dual horizon: the margin comes from the other side's δ): those rows, and
-    /// every node j (body or fictitious) whose horizon holds one of them, for w_ji. Every
-    /// other row is left empty. The search is that of [`Horizons::build`] over those rows.
+    /// every node j (body or fictitious) whose horizon holds one of them, for w_ji (on the
+    /// bucket grid, every node of the cells within the largest reach of theirs: a few more).
+    /// Every other row is left empty. The search is that of [`Horizons::build`] over those
+    /// rows.
     pub fn build_rows(cloud: &Cloud, kernel: &Kernel, rows: std::ops::Range<usize>) -> Self {
-        Self::search(cloud, kernel, true, Some(rows))
+        Self::build_rows_with(cloud, kernel, rows, true)
+    }
+
+    /// [`Horizons::build_rows`] with the bucket grid allowed or not (the k-d tree finds the
+    /// margin by a search at the largest reach).
+    pub fn build_rows_with(
+        cloud: &Cloud,
+        kernel: &Kernel,
+        rows: std::ops::Range<usize>,
+        grid: bool,
+    ) -> Self {
+        Self::search(cloud, kernel, grid, Some(rows))
     }
 
     /// The search of [`Horizons::build_with`]; with `rows`, that of [`Horizons::build_rows`].
@@ -371,7 +417,11 @@ impl Horizons {
         let reach = reaches(cloud, kernel);
         let finder = Finder::new(&pts, &reach, grid);
         let keep = |i: usize, j: usize| bond(cloud, kernel, i, j);
-        let wanted = rows.map(|rows| reaching(&finder, &pts, &reach, &keep, rows));
+        let wanted = rows.map(|rows| match &finder {
+            // a margin of whole cells: a few more rows than needed, no distance computed
+            Finder::Grid(g) => g.near(&pts, rows, reach.iter().cloned().fold(0.0, f64::max)),
+            Finder::Tree(_) => reaching(&finder, &pts, &reach, &keep, rows),
+        });
         // pass 1: sorted neighbour lists of each block of rows, and the row lengths
         let mut lens = vec![0usize; n];
         let blocks = search_blocks(&finder, &pts, &reach, &keep, wanted.as_deref(), &mut lens);
