@@ -194,6 +194,16 @@ enum Command {
         /// Bandwidth of the link between ranks, GB/s.
         #[arg(long, default_value_t = 12.5, value_parser = parse_positive)]
         link: f64,
+        /// Also write the plan as partition.json into this directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Also write the table, the commit and machine, and the check a rerun must pass into
+        /// this figure file (e.g. validation/partition_cube.json).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// The command that planned it, recorded in the figure file.
+        #[arg(long, default_value = "peritherm partition")]
+        command: String,
     },
 }
 
@@ -335,6 +345,9 @@ fn dispatch(
             bandwidth,
             latency,
             link,
+            out,
+            json,
+            command,
         } => {
             let machine = peritherm::planner::Machine {
                 bandwidth,
@@ -342,20 +355,54 @@ fn dispatch(
                 link,
             };
             let ranks: Vec<usize> = ranks.into_iter().map(|n| n as usize).collect();
-            partition(&case, &ranks, &machine)
+            let files = PlanFiles { out, json, command };
+            partition(&case, &ranks, &machine, &files)
         }
     }
 }
 
-/// `peritherm partition`: the plan of a case on each rank count, as a Markdown table.
+/// Where `peritherm partition` also writes its plan.
+struct PlanFiles {
+    /// A directory for partition.json.
+    out: Option<PathBuf>,
+    /// A figure file.
+    json: Option<PathBuf>,
+    /// The command recorded in the figure file.
+    command: String,
+}
+
+/// `peritherm partition`: the plan of a case on each rank count, as a Markdown table, and as
+/// partition.json and a figure file when asked.
 fn partition(
     path: &std::path::Path,
     ranks: &[usize],
     machine: &peritherm::planner::Machine,
+    files: &PlanFiles,
 ) -> anyhow::Result<()> {
+    use peritherm::planner;
     let case = Case::load(path)?;
-    let rows = peritherm::planner::plan(&case, ranks, machine)?;
-    say!("{}", peritherm::planner::markdown(&case, &rows, machine));
+    let rows = planner::plan(&case, ranks, machine)?;
+    let table = planner::markdown(&case, &rows, machine);
+    say!("{table}");
+    let json = planner::json(machine, &rows);
+    if let Some(dir) = &files.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        peritherm::atomic::write_atomic(&dir.join("partition.json"), json.as_bytes())?;
+    }
+    if let Some(file) = &files.json {
+        let list: Vec<String> = ranks.iter().map(|n| n.to_string()).collect();
+        let mut args = vec!["partition".into(), path.display().to_string()];
+        args.extend(["--ranks".into(), list.join(",")]);
+        args.extend(["--bandwidth".into(), machine.bandwidth.to_string()]);
+        args.extend(["--latency".into(), machine.latency.to_string()]);
+        args.extend(["--link".into(), machine.link.to_string()]);
+        let name = file
+            .file_stem()
+            .map_or("partition".into(), |s| s.to_string_lossy());
+        let f = planner::figures(&name, &files.command, &table, args, &json);
+        peritherm::atomic::write_atomic(file, f.to_json().as_bytes())?;
+        say!("-> {}", file.display());
+    }
     Ok(())
 }
 

@@ -20,7 +20,7 @@ const STREAM_BYTES_PER_PAIR: f64 = crate::bench::BYTES_PER_BOND;
 const STREAM_BYTES_PER_ROW: f64 = 24.0;
 
 /// The machine a plan is for: the parameters of the latency–bandwidth model.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Machine {
     /// Memory bandwidth of one rank (its share of a node's), GB/s.
     pub bandwidth: f64,
@@ -32,7 +32,7 @@ pub struct Machine {
 
 /// What the ranks of one rank count hold, at most or at least over the ranks, and the model's
 /// time per step.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct PlanRow {
     /// Number of ranks.
     pub ranks: usize,
@@ -148,4 +148,32 @@ pub fn markdown(case: &Case, rows: &[PlanRow], m: &Machine) -> String {
         );
     }
     s
+}
+
+/// The plan as JSON (`partition.json` of `peritherm partition --out DIR`): the machine and
+/// the rows; the same bytes whenever the same case and ranks are planned.
+pub fn json(machine: &Machine, rows: &[PlanRow]) -> String {
+    let v = serde_json::json!({ "machine": machine, "rows": rows });
+    serde_json::to_string_pretty(&v).expect("plain data serialises")
+}
+
+/// The plan as a figure file named `name` (`peritherm partition --json FILE`), measured by
+/// `command`, with its check: `args` (the arguments of `peritherm` that planned it) write
+/// `partition.json` with the same bytes.
+pub fn figures(
+    name: &str,
+    command: &str,
+    table: &str,
+    args: Vec<String>,
+    json: &str,
+) -> peritherm_post::figures::Figures {
+    use peritherm_post::figures::{fnv1a_hex, from_markdown, Check};
+    let provenance = crate::figures::provenance(rayon::current_num_threads());
+    let mut f = from_markdown(name, command, provenance, table);
+    f.checks.push(Check::File {
+        args,
+        file: "partition.json".into(),
+        fnv1a: fnv1a_hex(json.as_bytes()),
+    });
+    f
 }

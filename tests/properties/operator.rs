@@ -155,6 +155,13 @@ fn mirror_layers_keep_a_linear_field_steady_everywhere() {
 /// The dual-horizon plate with every lattice refined 2× (7040 body nodes, several tasks of
 /// [`peritherm::operator::ROW_CHUNK`] rows), with the given faces.
 fn refined_dual_horizon(faces: &str) -> Model {
+    let model = Model::build(&refined_dual_horizon_spec(faces)).unwrap();
+    assert!(model.cloud.n_body > 3 * peritherm::operator::ROW_CHUNK);
+    model
+}
+
+/// The spec of [`refined_dual_horizon`].
+fn refined_dual_horizon_spec(faces: &str) -> peritherm::model::ModelSpec {
     let mut spec = dual_horizon_case(faces, "lattice").spec;
     let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
         panic!("a box case")
@@ -163,9 +170,7 @@ fn refined_dual_horizon(faces: &str) -> Model {
         r.cells[0] *= 2;
         r.cells[1] *= 2;
     }
-    let model = Model::build(&spec).unwrap();
-    assert!(model.cloud.n_body > 3 * peritherm::operator::ROW_CHUNK);
-    model
+    spec
 }
 
 /// One region of 128 × 64 cells on the 2 × 1 plate (Δ = 2⁻⁶, so lattice offsets are exact and
@@ -637,14 +642,7 @@ fn abrupt_horizon_jumps_are_corrected_with_positive_conductances() {
 fn a_share_holds_the_whole_models_rows_bit_for_bit() {
     use peritherm::partition::{own_halo, publishers, rule_sources};
     use peritherm::solve::exchange::RankPlan;
-    let mut spec = dual_horizon_case(MIRROR_FACES, "lattice").spec;
-    let peritherm::model::Geometry::Box(g) = &mut spec.geometry else {
-        panic!("a box case")
-    };
-    for r in &mut g.regions {
-        r.cells[0] *= 2;
-        r.cells[1] *= 2;
-    }
+    let spec = refined_dual_horizon_spec(MIRROR_FACES);
     assert!(Model::shareable(&spec));
     let whole = Model::build(&spec).unwrap();
     let k = &whole.conductance;

@@ -1,7 +1,7 @@
 //! What the ranks of a distributed run tell one another: ghost temperatures before each
 //! boundary application ([`Exchange::halo`]), the whole field at outputs
 //! ([`Exchange::all_gather`]), and every global quantity through one reduction
-//! ([`Exchange::reduce`]), so that none is left per-rank.
+//! ([`Collective::reduce`]), so that none is left per-rank.
 //!
 //! The MPI implementation lives with the command line (cargo feature `mpi`); [`InProcess`]
 //! runs the same protocol between threads of one process, for tests and for machines
