@@ -68,8 +68,10 @@ pub struct Rank<'a> {
 
 /// Runs `case` on this rank's `model` (a share, or the whole model:
 /// [`crate::prepare::build_rank`]) as one rank of a distributed run over `exchange`:
-/// explicit runs step their rows only ([`crate::solve::explicit::Explicit::distribute`]), the
-/// other steppers step the whole model on every rank. Rank 0 writes `out` as a serial run
+/// explicit runs, phase change included, step their rows only
+/// ([`crate::solve::explicit::Explicit::distribute`],
+/// [`crate::solve::enthalpy::Enthalpic::distribute`]); the implicit steppers step the whole
+/// model on every rank. Rank 0 writes `out` as a serial run
 /// would, with the same bits, and returns the summary; the other ranks return None. A rank
 /// that fails stops all of them.
 pub fn run_ranked<'a>(
@@ -86,7 +88,11 @@ pub fn run_ranked<'a>(
             e.distribute(exchange);
             "rows"
         }
-        _ => "replicated",
+        Engine::Enthalpic(e) => {
+            e.distribute(exchange);
+            "rows"
+        }
+        Engine::Implicit(_) => "replicated",
     };
     let rank = Rank { exchange, mode };
     if exchange.rank() != 0 {

@@ -153,9 +153,14 @@ fn explicit_cases_give_the_serial_bits() {
 }
 
 #[test]
-fn replicated_steppers_give_the_serial_bits() {
-    // phase change (enthalpy) and an implicit scheme: every rank steps the whole model
-    for case in ["ice_in_water.toml", "pipe_freezing.toml"] {
+fn phase_change_and_implicit_steppers_give_the_serial_bits() {
+    // phase change (the enthalpy stepper steps each rank's rows, ghost enthalpies exchanged),
+    // in a plane and axisymmetric; an implicit scheme (every rank steps the whole model)
+    for case in [
+        "ice_in_water.toml",
+        "pipe_freezing.toml",
+        "thermal_shock_k1_m1_implicit.toml",
+    ] {
         same_under_mpiexec(case);
     }
 }

@@ -493,18 +493,17 @@ impl Model {
     }
 
     /// Whether a spec can be built one rank's share at a time ([`Model::build_share`]): every
-    /// row of K depends on its own neighbourhood only (cracks too: their cuts, the restored
-    /// moment and the damage are per row). Not so for the consistent weights (one global
-    /// solve), nodal flux relations (their micro-conductances) and phase change (its stepper
-    /// is not distributed).
+    /// row of K depends on its own neighbourhood only (cracks and phase change too: their
+    /// cuts, restored moments, damage and unit conductances are per row). Not so for the
+    /// consistent weights (one global solve) and nodal flux relations (their
+    /// micro-conductances).
     pub fn shareable(spec: &ModelSpec) -> bool {
         let corrected = spec.consistency != Order::None && !spec.symmetry.is_symmetric();
         let relation = spec
             .faces
             .iter()
             .any(|f| matches!(f, FaceBc::RelationFlux { .. }));
-        let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
-        !(corrected || relation || phase)
+        !(corrected || relation)
     }
 
     /// The share of rank `rank` of `ranks` of a [`Model::shareable`] spec, and the partition

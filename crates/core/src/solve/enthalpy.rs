@@ -12,9 +12,11 @@ use crate::error::{Error, Result};
 use crate::material::Enthalpy;
 use crate::model::Model;
 use crate::operator::Conductance;
+use crate::solve::exchange::Exchange;
 use crate::solve::integrator::Integrator;
-use crate::solve::stepper::{march, RunStats, Stepper};
+use crate::solve::stepper::{check_finite, first_non_finite, march, RunStats, Stepper};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Enthalpy-form explicit integrator state with preallocated buffers.
 pub struct Enthalpic<'a> {
@@ -33,6 +35,10 @@ pub struct Enthalpic<'a> {
     scaled: Conductance,
     /// Whether `h` and `lambda` have been set from a temperature field.
     ready: bool,
+    /// The body rows this stepper computes (all of them, or one rank's).
+    rows: Range<usize>,
+    /// The other ranks of a distributed run.
+    exchange: Option<&'a dyn Exchange>,
 }
 
 impl<'a> Enthalpic<'a> {
@@ -69,7 +75,59 @@ impl<'a> Enthalpic<'a> {
             unit: vec![1.0; nb],
             scaled: model.conductance.clone(),
             ready: false,
+            rows: 0..nb,
+            exchange: None,
         })
+    }
+
+    /// Makes this stepper one rank of a distributed run: it computes the rows of `exchange`
+    /// and, before every boundary application, receives the enthalpies of its ghosts (their
+    /// temperatures and conductivities follow from them); at outputs every rank holds every
+    /// node's state. The bits are a serial run's (each row keeps its order).
+    pub fn distribute(&mut self, exchange: &'a dyn Exchange) {
+        self.rows = exchange.rows();
+        self.exchange = Some(exchange);
+    }
+
+    /// Receives the enthalpies of the ghosts and sets their temperatures and conductivities
+    /// from them (driven ghosts are set by the boundary, as their owners set them).
+    fn fill_ghosts(&mut self, theta: &mut [f64]) {
+        let Some(ex) = self.exchange else {
+            return;
+        };
+        ex.halo(&mut self.h);
+        let (m, relation) = (self.model, self.relation);
+        for (_, nodes) in &ex.plan().halo.recv {
+            for &j in nodes {
+                let j = j as usize;
+                if !m.boundary.driven[j] {
+                    let e = &relation[m.cloud.material[j] as usize];
+                    theta[j] = e.temperature(self.h[j]);
+                    self.lambda[j] = e.conductivity(self.h[j]);
+                }
+            }
+        }
+    }
+
+    /// Every rank takes every node's state (θ, H and λ) from their owners (a distributed run).
+    fn gather(&mut self, theta: &mut [f64]) {
+        let Some(ex) = self.exchange else {
+            return;
+        };
+        ex.all_gather(theta);
+        let nb = self.h.len();
+        let mut all = vec![0.0; theta.len()];
+        all[..nb].copy_from_slice(&self.h);
+        ex.all_gather(&mut all);
+        self.h.copy_from_slice(&all[..nb]);
+        let (relation, material) = (self.relation, &self.model.cloud.material);
+        for (i, (l, &th)) in self.lambda.iter_mut().zip(theta.iter()).enumerate() {
+            let e = &relation[material[i] as usize];
+            *l = match i < nb {
+                true => e.conductivity(self.h[i]),
+                false => e.conductivity(e.enthalpy(th)),
+            };
+        }
     }
 
     fn of(&self, i: usize) -> &Enthalpy {
@@ -139,11 +197,13 @@ impl<'a> Enthalpic<'a> {
         let rule = m.bond_rule;
         let (lambda, driven, volume) = (&self.lambda, &m.boundary.driven, &m.cloud.volume);
         let th: &[f64] = theta;
-        self.rate
+        let rows = self.rows.clone();
+        self.rate[rows.clone()]
             .par_iter_mut()
             .with_min_len(1024)
             .enumerate()
-            .for_each(|(i, r)| {
+            .for_each(|(r0, r)| {
+                let i = rows.start + r0;
                 *r = if driven[i] {
                     0.0
                 } else {
@@ -163,14 +223,15 @@ impl<'a> Enthalpic<'a> {
         }
         let relation = self.relation;
         let material = &m.cloud.material;
-        theta[..self.h.len()]
+        theta[rows.clone()]
             .par_iter_mut()
             .with_min_len(4096)
-            .zip(self.h.par_iter_mut())
-            .zip(self.lambda.par_iter_mut())
-            .zip(&self.rate)
+            .zip(self.h[rows.clone()].par_iter_mut())
+            .zip(self.lambda[rows.clone()].par_iter_mut())
+            .zip(&self.rate[rows.clone()])
             .enumerate()
-            .for_each(|(i, (((y, hi), li), r))| {
+            .for_each(|(r0, (((y, hi), li), r))| {
+                let i = rows.start + r0;
                 if !driven[i] {
                     let e = &relation[material[i] as usize];
                     *hi += h * r;
@@ -178,6 +239,7 @@ impl<'a> Enthalpic<'a> {
                     *li = e.conductivity(*hi);
                 }
             });
+        self.fill_ghosts(theta);
         self.constrain(theta, t + h);
     }
 
@@ -255,6 +317,13 @@ impl Stepper for Enthalpic<'_> {
     fn advance(&mut self, theta: &mut [f64], t: f64, _t1: f64, h: f64) -> Result<()> {
         self.step(theta, t, h);
         Ok(())
+    }
+    fn check(&self, theta: &[f64], t: f64) -> Result<()> {
+        first_non_finite(theta, self.rows.clone(), self.exchange, t)
+    }
+    fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
+        self.gather(theta);
+        check_finite(theta, self.model.cloud.n_body, t)
     }
     fn conductance_now(&mut self) -> &Conductance {
         self.scale_conductance();

@@ -8,7 +8,7 @@
 use crate::error::Result;
 use crate::model::Model;
 use crate::operator::{row_sum, Conductance, ROW_CHUNK};
-use crate::solve::exchange::{Exchange, Reduce};
+use crate::solve::exchange::Exchange;
 use crate::stencil::Stencils;
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -16,6 +16,7 @@ use std::ops::Range;
 
 // the integrator and the stepping interface under their old paths
 pub use crate::solve::integrator::{choose_dt, count_steps, steps_between, Integrator};
+use crate::solve::stepper::first_non_finite;
 pub use crate::solve::stepper::{check_finite, RunStats};
 use crate::solve::stepper::{march, Stepper};
 
@@ -336,22 +337,7 @@ impl Stepper for Explicit<'_> {
         Ok(())
     }
     fn check(&self, theta: &[f64], t: f64) -> Result<()> {
-        let Some(ex) = self.exchange else {
-            return check_finite(theta, self.model.cloud.n_body, t);
-        };
-        // the first non-finite node over all ranks, so that every rank stops together
-        let rows = self.rows.clone();
-        let local = theta[rows.clone()]
-            .iter()
-            .position(|v| !v.is_finite())
-            .map_or(f64::INFINITY, |p| (rows.start + p) as f64);
-        match ex.reduce(local, Reduce::Min) {
-            node if node.is_finite() => Err(crate::Error::NonFinite {
-                node: node as usize,
-                time: t,
-            }),
-            _ => Ok(()),
-        }
+        first_non_finite(theta, self.rows.clone(), self.exchange, t)
     }
     fn settle(&mut self, theta: &mut [f64], t: f64) -> Result<()> {
         if let Some(ex) = self.exchange {

@@ -91,6 +91,31 @@ pub fn check_finite(theta: &[f64], nb: usize, t: f64) -> Result<()> {
     }
 }
 
+/// [`check_finite`] of a stepper that computes the body rows `rows`: a distributed run's
+/// (`exchange`) checks its own rows and finds the first non-finite node over all ranks, so
+/// that every rank stops together.
+pub fn first_non_finite(
+    theta: &[f64],
+    rows: std::ops::Range<usize>,
+    exchange: Option<&dyn crate::solve::exchange::Exchange>,
+    t: f64,
+) -> Result<()> {
+    let Some(ex) = exchange else {
+        return check_finite(theta, rows.end, t);
+    };
+    let local = theta[rows.clone()]
+        .iter()
+        .position(|v| !v.is_finite())
+        .map_or(f64::INFINITY, |p| (rows.start + p) as f64);
+    match ex.reduce(local, crate::solve::exchange::Reduce::Min) {
+        node if node.is_finite() => Err(Error::NonFinite {
+            node: node as usize,
+            time: t,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// The fixed-step time loop of every stepper: steps no longer than `dt` (s) that land on each
 /// output time (s), a NaN check every 4096 steps and at every output, where
 /// `at_output(stepper, k, t, θ)` is called; `progress(steps)` every
