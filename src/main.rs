@@ -179,32 +179,36 @@ enum Command {
     /// Print what each of N MPI ranks would hold and exchange in a run of a case (nodes,
     /// ghosts, bonds, memory, halo bytes) and a time per step from a latency–bandwidth model,
     /// without running it (docs/distributed.md).
-    Partition {
-        /// The case file (TOML).
-        case: PathBuf,
-        /// Rank counts, comma-separated (e.g. 1,64,4096).
-        #[arg(long, value_delimiter = ',', required = true, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
-        ranks: Vec<u32>,
-        /// Memory bandwidth of one rank (its share of a node's), GB/s.
-        #[arg(long, default_value_t = 5.0, value_parser = parse_positive)]
-        bandwidth: f64,
-        /// Latency of a message between ranks, µs.
-        #[arg(long, default_value_t = 2.0, value_parser = parse_positive)]
-        latency: f64,
-        /// Bandwidth of the link between ranks, GB/s.
-        #[arg(long, default_value_t = 12.5, value_parser = parse_positive)]
-        link: f64,
-        /// Also write the plan as partition.json into this directory.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Also write the table, the commit and machine, and the check a rerun must pass into
-        /// this figure file (e.g. validation/partition_cube.json).
-        #[arg(long, value_name = "FILE")]
-        json: Option<PathBuf>,
-        /// The command that planned it, recorded in the figure file.
-        #[arg(long, default_value = "peritherm partition")]
-        command: String,
-    },
+    Partition(PartitionArgs),
+}
+
+/// The arguments of `peritherm partition`.
+#[derive(clap::Args)]
+struct PartitionArgs {
+    /// The case file (TOML).
+    case: PathBuf,
+    /// Rank counts, comma-separated (e.g. 1,64,4096).
+    #[arg(long, value_delimiter = ',', required = true, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    ranks: Vec<u32>,
+    /// Memory bandwidth of one rank (its share of a node's), GB/s.
+    #[arg(long, default_value_t = 5.0, value_parser = parse_positive)]
+    bandwidth: f64,
+    /// Latency of a message between ranks, µs.
+    #[arg(long, default_value_t = 2.0, value_parser = parse_positive)]
+    latency: f64,
+    /// Bandwidth of the link between ranks, GB/s.
+    #[arg(long, default_value_t = 12.5, value_parser = parse_positive)]
+    link: f64,
+    /// Also write the plan as partition.json into this directory.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Also write the table, the commit and machine, and the check a rerun must pass into
+    /// this figure file (e.g. validation/partition_cube.json).
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// The command that planned it, recorded in the figure file.
+    #[arg(long, default_value = "peritherm partition")]
+    command: String,
 }
 
 /// Parses a finite positive number of a model parameter.
@@ -339,57 +343,31 @@ fn dispatch(
             bench(&opts, json.as_deref(), &command)
         }
         Command::Check { case } => check(&case, options),
-        Command::Partition {
-            case,
-            ranks,
-            bandwidth,
-            latency,
-            link,
-            out,
-            json,
-            command,
-        } => {
-            let machine = peritherm::planner::Machine {
-                bandwidth,
-                latency,
-                link,
-            };
-            let ranks: Vec<usize> = ranks.into_iter().map(|n| n as usize).collect();
-            let files = PlanFiles { out, json, command };
-            partition(&case, &ranks, &machine, &files)
-        }
+        Command::Partition(args) => partition(&args),
     }
-}
-
-/// Where `peritherm partition` also writes its plan.
-struct PlanFiles {
-    /// A directory for partition.json.
-    out: Option<PathBuf>,
-    /// A figure file.
-    json: Option<PathBuf>,
-    /// The command recorded in the figure file.
-    command: String,
 }
 
 /// `peritherm partition`: the plan of a case on each rank count, as a Markdown table, and as
 /// partition.json and a figure file when asked.
-fn partition(
-    path: &std::path::Path,
-    ranks: &[usize],
-    machine: &peritherm::planner::Machine,
-    files: &PlanFiles,
-) -> anyhow::Result<()> {
+fn partition(a: &PartitionArgs) -> anyhow::Result<()> {
     use peritherm::planner;
+    let machine = &planner::Machine {
+        bandwidth: a.bandwidth,
+        latency: a.latency,
+        link: a.link,
+    };
+    let ranks: Vec<usize> = a.ranks.iter().map(|&n| n as usize).collect();
+    let path = &a.case;
     let case = Case::load(path)?;
-    let rows = planner::plan(&case, ranks, machine)?;
+    let rows = planner::plan(&case, &ranks, machine)?;
     let table = planner::markdown(&case, &rows, machine);
     say!("{table}");
     let json = planner::json(machine, &rows);
-    if let Some(dir) = &files.out {
+    if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         peritherm::atomic::write_atomic(&dir.join("partition.json"), json.as_bytes())?;
     }
-    if let Some(file) = &files.json {
+    if let Some(file) = &a.json {
         let list: Vec<String> = ranks.iter().map(|n| n.to_string()).collect();
         let mut args = vec!["partition".into(), path.display().to_string()];
         args.extend(["--ranks".into(), list.join(",")]);
@@ -399,7 +377,7 @@ fn partition(
         let name = file
             .file_stem()
             .map_or("partition".into(), |s| s.to_string_lossy());
-        let f = planner::figures(&name, &files.command, &table, args, &json);
+        let f = planner::figures(&name, &a.command, &table, args, &json);
         peritherm::atomic::write_atomic(file, f.to_json().as_bytes())?;
         say!("-> {}", file.display());
     }

@@ -238,10 +238,7 @@ fn execute(
         return Err(ready.err().unwrap_or(Error::Peer));
     }
     let (origin, mut writer) = ready?;
-    if let Some(ex) = ex.filter(|ex| ex.size() > 1) {
-        let p = &ex.plan().partition;
-        writer.pieces = (0..p.ranks()).map(|r| p.range(r)).collect();
-    }
+    writer.pieces = pieces(ex);
     let fem_seconds = t_run.elapsed().as_secs_f64();
     let reference = writer.reference.clone();
     // the steppers stop at the outputs and at the history's samples
@@ -265,8 +262,7 @@ fn execute(
             (_, w) => w,
         }
     };
-    let t_last = case.outputs.last().copied().unwrap_or(case.end);
-    let adaptive = schedule.adaptive.is_some();
+    let on_step = step_progress(case, &schedule, total, &mut progress);
     let stats = integrate(
         &mut engine,
         &schedule,
@@ -274,22 +270,12 @@ fn execute(
         0.0,
         &times,
         on_output,
-        |s, t| {
-            reached(t);
-            // adaptive: the number of steps is not known; extrapolate it from the time reached
-            match adaptive {
-                true => progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64),
-                false => progress(s, total),
-            }
-        },
+        on_step,
     )
     .map_err(|e| run_error(case, model, e))?;
     // the last collective: whatever fails below fails on rank 0 alone
     let ranks = rank.map(|r| ranks(model, r));
-    let history = match &recorder {
-        Some(r) => Some(r.write(out)?),
-        None => None,
-    };
+    let history = recorder.as_ref().map(|r| r.write(out)).transpose()?;
     let timing = Timing {
         setup_seconds,
         run_seconds: t_run.elapsed().as_secs_f64(),
@@ -299,17 +285,54 @@ fn execute(
     summary.initial_energy = initial_energy;
     summary.history = history;
     summary.origin = Some(origin);
+    with_ranks(&mut summary, model, ranks);
+    summary.write(out)?;
+    Ok(summary)
+}
+
+/// What a run reports after each step `s` reaching `t` (s): the time reached (for an
+/// interrupted run) and `progress(done, total)` (adaptive: the number of steps is not known,
+/// it is extrapolated from the time reached).
+fn step_progress<'p>(
+    case: &Case,
+    schedule: &Schedule,
+    total: u64,
+    progress: &'p mut impl FnMut(u64, u64),
+) -> impl FnMut(u64, f64) + 'p {
+    let t_last = case.outputs.last().copied().unwrap_or(case.end);
+    let adaptive = schedule.adaptive.is_some();
+    move |s, t| {
+        reached(t);
+        match adaptive {
+            true => progress(s, ((s as f64) * t_last / t.max(f64::MIN_POSITIVE)) as u64),
+            false => progress(s, total),
+        }
+    }
+}
+
+/// The body rows of each rank of a distributed run, one VTK piece each; none for a serial
+/// run or one rank.
+fn pieces(exchange: Option<&dyn Exchange>) -> Vec<std::ops::Range<usize>> {
+    match exchange.filter(|ex| ex.size() > 1) {
+        Some(ex) => {
+            let p = &ex.plan().partition;
+            (0..p.ranks()).map(|r| p.range(r)).collect()
+        }
+        None => Vec::new(),
+    }
+}
+
+/// Puts the ranks' sizes into `summary`; a share holds its own rows' bonds, so the model's
+/// bonds and pairs are the sums over the ranks.
+fn with_ranks(summary: &mut RunSummary, model: &Model, ranks: Option<Ranks>) {
     if let Some(r) = ranks
         .as_ref()
         .filter(|_| model.rows != (0..model.cloud.n_body))
     {
-        // a share holds its own rows' bonds: the model's are those of every rank
         summary.bonds = r.bonds.iter().sum();
         summary.pairs = r.pairs.iter().sum();
     }
     summary.ranks = ranks;
-    summary.write(out)?;
-    Ok(summary)
 }
 
 /// A time-loop error keyed to the case: a non-finite temperature names the key that most

@@ -633,3 +633,61 @@ fn a_build_without_mpi_refuses_to_run_as_ranks() {
         assert!(!out.exists());
     }
 }
+
+/// `peritherm partition` plans without running: the plan of one rank holds the model's bonds
+/// (as `run` counts them), two ranks split the nodes and the bonds, `--out` writes partition.json with the
+/// same bytes each time, and a rank count of 0 or a missing case is refused with one line.
+#[test]
+fn partition_plans_the_ranks_without_running() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/dh_plate_k0.5_m1.toml");
+    let run = dir.path().join("run");
+    let o = crate::common::cli::peritherm(&["run", case, "--out", run.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary = peritherm::output::RunSummary::read(&run).unwrap();
+    let plan = |out: &Path| {
+        let o = crate::common::cli::peritherm(&[
+            "partition",
+            case,
+            "--ranks",
+            "1,2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(out.join("partition.json")).unwrap()
+    };
+    let (a, b) = (plan(&dir.path().join("a")), plan(&dir.path().join("b")));
+    assert_eq!(a, b, "the same plan twice");
+    let v: serde_json::Value = serde_json::from_str(&a).unwrap();
+    assert_eq!(v["rows"][0]["bonds"].as_u64(), Some(summary.bonds as u64));
+    let half = v["rows"][1]["nodes"].as_array().unwrap();
+    let (lo, hi) = (half[0].as_u64().unwrap(), half[1].as_u64().unwrap());
+    assert_eq!(
+        lo + hi,
+        summary.nodes as u64,
+        "two ranks hold every node once"
+    );
+    // cut by pairs, not nodes (the fine region's rows are longer): neither rank holds more
+    // than 60 % of the bonds
+    let most = v["rows"][1]["bonds"].as_u64().unwrap() as f64;
+    assert!(
+        most <= 0.6 * summary.bonds as f64,
+        "{most} of {} bonds",
+        summary.bonds
+    );
+    assert!(v["rows"][1]["ghosts"].as_u64().unwrap() > 0);
+    for args in [
+        vec!["partition", case, "--ranks", "0"],
+        vec!["partition", "no-such-case.toml", "--ranks", "2"],
+    ] {
+        let o = crate::common::cli::peritherm(&args);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            err.lines().filter(|l| l.starts_with("error")).count(),
+            1,
+            "{err}"
+        );
+    }
+}

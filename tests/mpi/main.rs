@@ -132,7 +132,49 @@ fn same_under_mpiexec(case: &str) {
         );
         let what = format!("{case} on {ranks} ranks ({}, {setup})", r.mode);
         same_field_files(&serial, &out, &fields, &what);
+        planned_as_run(&path, ranks, &r, &what);
     }
+}
+
+/// `peritherm partition` plans what the run held: the most nodes, ghosts and bonds of a rank
+/// are those run.json reports for the same rank count.
+fn planned_as_run(case: &Path, ranks: usize, run: &peritherm::output::Ranks, what: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let o = command()
+        .args([
+            "partition",
+            case.to_str().unwrap(),
+            "--ranks",
+            &ranks.to_string(),
+        ])
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("partition.json")).unwrap();
+    let plan: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let row = &plan["rows"][0];
+    let most = |v: &[usize]| *v.iter().max().unwrap() as u64;
+    assert_eq!(
+        row["nodes"][1].as_u64(),
+        Some(most(&run.nodes)),
+        "{what}: nodes"
+    );
+    assert_eq!(
+        row["ghosts"].as_u64(),
+        Some(most(&run.ghosts)),
+        "{what}: ghosts"
+    );
+    assert_eq!(
+        row["bonds"].as_u64(),
+        Some(most(&run.bonds)),
+        "{what}: bonds"
+    );
 }
 
 #[test]
