@@ -136,10 +136,13 @@ fn output_fields(
             q[axis] = *p;
         }
     }
-    let n = damage.len();
-    part[..n].copy_from_slice(&damage);
-    ex.all_gather(&mut part);
-    damage.copy_from_slice(&part[..n]);
+    if !model.crack_cuts.mu.is_empty() {
+        // without cracks the damage is 0 everywhere, on every rank alike
+        let n = damage.len();
+        part[..n].copy_from_slice(&damage);
+        ex.all_gather(&mut part);
+        damage.copy_from_slice(&part[..n]);
+    }
     (flux, damage)
 }
 

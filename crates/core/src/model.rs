@@ -447,6 +447,24 @@ fn heat_properties(
     (enthalpy, conductivity, capacity)
 }
 
+/// What every build of a spec starts with: the materials checked (true with phase change),
+/// the faces that carry a fictitious layer, and the cloud.
+fn prelude(spec: &ModelSpec) -> Result<(bool, Vec<bool>, Cloud)> {
+    let phase = check_spec(spec)?;
+    let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
+    let cloud = build_cloud(spec, &layered)?;
+    Ok((phase, layered, cloud))
+}
+
+/// The conductivity (W/(m·K)) and volumetric heat capacity (J/(m³·K)) of every node's
+/// material.
+fn heat_of(spec: &ModelSpec, cloud: &Cloud) -> (Vec<f64>, Vec<f64>) {
+    let mat = |i: usize| spec.materials[cloud.material[i] as usize];
+    let conductivity = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
+    let capacity = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
+    (conductivity, capacity)
+}
+
 /// The boundary of `cloud` (`heat`: conductivity and capacity per node; `micro`: the bonds'
 /// micro-conductances, for nodal flux relations).
 fn boundary_of(
@@ -472,21 +490,15 @@ impl Model {
     /// The cloud and boundary of a spec without any bond (for planning a distributed run:
     /// [`crate::partition::loads`]); nodal flux relations get no micro-conductances.
     pub fn outline(spec: &ModelSpec) -> Result<(Cloud, Boundary)> {
-        let phase = check_spec(spec)?;
-        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
-        let cloud = build_cloud(spec, &layered)?;
-        let mat = |i: usize| spec.materials[cloud.material[i] as usize];
-        let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
-        let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
+        let (phase, _, cloud) = prelude(spec)?;
+        let (conductivity, capacity) = heat_of(spec, &cloud);
         let boundary = boundary_of(spec, &cloud, phase, (&conductivity, &capacity), None);
         Ok((cloud, boundary))
     }
 
     /// Builds cloud, bonds, conductance and boundary from a spec.
     pub fn build(spec: &ModelSpec) -> Result<Model> {
-        let phase = check_spec(spec)?;
-        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
-        let cloud = build_cloud(spec, &layered)?;
+        let (phase, layered, cloud) = prelude(spec)?;
         let horizons = Horizons::build(&cloud, &spec.kernel);
         let rows = 0..cloud.n_body;
         Self::finish(spec, cloud, horizons, phase, &layered, rows)
@@ -512,9 +524,7 @@ impl Model {
     /// alone, with the margin of rows their assembly reads ([`Horizons::build_rows`]). Its
     /// rows have the bits of [`Model::build`]'s; the others are empty.
     pub fn build_share(spec: &ModelSpec, ranks: usize, rank: usize) -> Result<(Model, Partition)> {
-        let phase = check_spec(spec)?;
-        let layered: Vec<bool> = spec.faces.iter().map(FaceBc::needs_layer).collect();
-        let cloud = build_cloud(spec, &layered)?;
+        let (phase, layered, cloud) = prelude(spec)?;
         let partition = Partition::by_estimate(&cloud, ranks);
         let rows = partition.range(rank.min(partition.ranks() - 1));
         let horizons = Horizons::build_rows(&cloud, &spec.kernel, rows.clone());
@@ -551,9 +561,7 @@ impl Model {
         layered: &[bool],
         rows: Range<usize>,
     ) -> Result<Model> {
-        let mat = |i: usize| spec.materials[cloud.material[i] as usize];
-        let conductivity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).conductivity).collect();
-        let capacity: Vec<f64> = (0..cloud.len()).map(|i| mat(i).capacity()).collect();
+        let (conductivity, capacity) = heat_of(spec, &cloud);
         // with phase change, K for unit conductivity; λ̄_ij(t) scales it as the state evolves
         let bond_conductivity = if phase {
             vec![1.0; cloud.len()]

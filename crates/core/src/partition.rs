@@ -28,14 +28,6 @@ pub struct Partition {
 }
 
 impl Partition {
-    /// Cuts the rows of K into `ranks` contiguous ranges of nearly equal work: pairs plus
-    /// [`ROW_WORK`] per row (variable-resolution clouds have rows of very different length,
-    /// so equal node counts would not balance). `ranks` of 0 is taken as 1.
-    pub fn by_work(conductance: &Conductance, ranks: usize) -> Self {
-        let offsets = &conductance.offsets;
-        Self::by_cumulative(offsets.len() - 1, ranks, |i| offsets[i] + ROW_WORK * i)
-    }
-
     /// Cuts the body rows of `cloud` into `ranks` contiguous ranges of nearly equal estimated
     /// work, before any bond exists: the pairs of row i taken as the nodes of spacing Δ_i in
     /// a ball of radius δ_i + Δ_i/2 (exact in the bulk of a lattice; dual-horizon transitions
@@ -352,7 +344,8 @@ mod tests {
     fn ranges_cover_the_rows_once_and_balance_the_work() {
         let k = chain(1000);
         for ranks in [1, 2, 3, 7, 1000, 1500] {
-            let p = Partition::by_work(&k, ranks);
+            // the work of rows 0..i: their pairs plus ROW_WORK each
+            let p = Partition::by_cumulative(1000, ranks, |i| k.offsets[i] + ROW_WORK * i);
             assert_eq!(p.ranks(), ranks);
             assert_eq!((p.bounds[0], p.bounds[ranks]), (0, 1000));
             assert!(p.bounds.windows(2).all(|w| w[0] <= w[1]));
