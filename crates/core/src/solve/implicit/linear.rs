@@ -10,7 +10,7 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::LltRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, SymbolicLu};
 use faer::sparse::linalg::lu::{LuRef, NumericLu};
@@ -162,11 +162,91 @@ pub(super) enum Guess {
     Preset,
 }
 
-/// Coefficients whose CG time is remembered by [`Solver::Auto`].
+/// Coefficients whose CG work is remembered by [`Solver::Auto`].
 pub(super) const RENT_SLOTS: usize = 64;
-/// Before any factorisation is timed, [`Solver::Auto`] estimates one as this many CG
-/// iterations times nnz(L)/nnz(A) (measured: crack plate 1.0 s ≈ 17, thermal shock 6.9 s ≈ 9).
-pub(super) const FACTOR_PER_FILL: f64 = 15.0;
+/// Multiply-adds of a numeric factorisation done in the time of one CG work unit (one stored
+/// entry of A read and multiplied): the dense kernels of a supernodal factorisation run at
+/// several times the rate of the memory-bound CG loop. Measured on 2 threads: 1.0–1.4e-10 s
+/// per multiply-add against 0.9–1.05e-9 s per CG unit on the two bundled adaptive cases
+/// (crack plate, thermal shock), a ratio of 7–9.
+pub(super) const FACTOR_FLOPS_PER_UNIT: f64 = 8.0;
+
+/// [`Solver::Auto`]'s ledger, counted in work units rather than seconds so that the choice
+/// depends on the system alone: the same case takes the same path, and gives the same bits,
+/// on any machine, thread count, load or rank.
+pub(super) struct Ledger {
+    /// Work of one CG iteration: nnz(A) + 6n (product and vector updates).
+    iteration: f64,
+    /// Work of one direct solve: a forward and a backward sweep over L.
+    direct: f64,
+    /// Work of one numeric factorisation: its multiply-adds / [`FACTOR_FLOPS_PER_UNIT`].
+    factor: f64,
+    /// CG work beyond a direct solve's, spent per coefficient c not factorised.
+    spent: Vec<(f64, f64)>,
+}
+
+impl Ledger {
+    /// The costs of CG, direct solves and factorisations of `sys` with the symbolic `chol`.
+    pub(super) fn new(sys: &System, chol: Option<&SymbolicCholesky<usize>>) -> Self {
+        let n = sys.len() as f64;
+        Ledger {
+            iteration: sys.vals.len() as f64 + 6.0 * n,
+            direct: chol.map_or(0.0, |s| 2.0 * s.len_val() as f64),
+            factor: chol.map_or(f64::INFINITY, |s| {
+                factor_multiply_adds(s) / FACTOR_FLOPS_PER_UNIT
+            }),
+            spent: Vec::with_capacity(RENT_SLOTS),
+        }
+    }
+
+    /// True while the CG work spent on `c` is below one factorisation's (the ski-rental rule:
+    /// at most twice the cheaper choice's cost).
+    fn rent_cg(&self, c: f64) -> bool {
+        let spent = self
+            .spent
+            .iter()
+            .find(|(k, _)| Implicit::same(*k, c))
+            .map_or(0.0, |r| r.1);
+        spent < self.factor
+    }
+
+    /// Adds what `iterations` of CG on coefficient c cost beyond a direct solve.
+    fn pay(&mut self, c: f64, iterations: u64) {
+        let work = (iterations as f64 * self.iteration - self.direct).max(0.0);
+        if let Some(r) = self.spent.iter_mut().find(|(k, _)| Implicit::same(*k, c)) {
+            r.1 += work;
+            return;
+        }
+        if self.spent.len() == RENT_SLOTS {
+            self.spent.remove(0);
+        }
+        self.spent.push((c, work));
+    }
+}
+
+/// Multiply-adds of one numeric Cholesky factorisation with the symbolic structure `s`: per
+/// supernode of w columns and h rows below it, w³/6 (its diagonal block) + h·w²/2 (the
+/// panel's triangular solve) + h²·w/2 (its update of the rest); per simplicial column of h
+/// entries below the diagonal, h²/2 + h.
+pub(super) fn factor_multiply_adds(s: &SymbolicCholesky<usize>) -> f64 {
+    match s.raw() {
+        SymbolicCholeskyRaw::Supernodal(sn) => (0..sn.n_supernodes())
+            .map(|k| {
+                let w = (sn.supernode_end()[k] - sn.supernode_begin()[k]) as f64;
+                let h = sn.supernode(k).pattern().len() as f64;
+                w * w * w / 6.0 + h * w * w / 2.0 + h * h * w / 2.0
+            })
+            .sum(),
+        SymbolicCholeskyRaw::Simplicial(sp) => sp
+            .col_ptr()
+            .windows(2)
+            .map(|c| {
+                let h = (c[1] - c[0]).saturating_sub(1) as f64;
+                h * h / 2.0 + h
+            })
+            .sum(),
+    }
+}
 
 impl Implicit<'_> {
     /// Makes sure a factorisation of `cM + A` is cached; returns its slot.
@@ -225,8 +305,7 @@ impl Implicit<'_> {
         }
         self.factors.push((c, factor));
         self.stats.factorisations += 1;
-        self.last_factor_seconds = started.elapsed().as_secs_f64();
-        self.stats.factor_seconds += self.last_factor_seconds;
+        self.stats.factor_seconds += started.elapsed().as_secs_f64();
         Ok(self.factors.len() - 1)
     }
 
@@ -235,53 +314,18 @@ impl Implicit<'_> {
         (k - c).abs() <= 1e-12 * c.abs().max(f64::MIN_POSITIVE)
     }
 
-    /// [`Solver::Auto`]: solve with CG while the seconds its solves on `c` took beyond a direct
-    /// solve (the last one timed; 0 before any) are below the cost of one factorisation, then
-    /// factorise (the ski-rental rule: at most twice the cheaper choice's cost). The cost is
-    /// the last factorisation's time; before any, CG iterations scaled by the factor's fill
-    /// ([`FACTOR_PER_FILL`]). So CG stays wherever it is cheaper per solve than the factor.
+    /// [`Solver::Auto`]: solve with CG while its work on `c` beyond direct solves is below one
+    /// factorisation's ([`Ledger`]); a coefficient already factorised is solved directly.
     pub(super) fn use_cg(&self, c: f64) -> bool {
         match self.options.solver {
             Solver::Cg => true,
             Solver::Direct => false,
             Solver::Auto => {
-                let Some(chol) = &self.chol else {
-                    return false;
-                };
-                if self.factors.iter().any(|(k, _)| Self::same(*k, c)) {
-                    return false;
-                }
-                let spent = self
-                    .rent
-                    .iter()
-                    .find(|(k, _)| Self::same(*k, c))
-                    .map_or(0.0, |r| r.1);
-                let cost = if self.last_factor_seconds > 0.0 {
-                    self.last_factor_seconds
-                } else if self.stats.cg_iterations > 0 {
-                    let per_iteration = self.cg_seconds / self.stats.cg_iterations as f64;
-                    let fill = chol.len_val() as f64 / self.sys.vals.len() as f64;
-                    FACTOR_PER_FILL * fill * per_iteration
-                } else {
-                    f64::INFINITY
-                };
-                spent < cost
+                self.chol.is_some()
+                    && !self.factors.iter().any(|(k, _)| Self::same(*k, c))
+                    && self.ledger.rent_cg(c)
             }
         }
-    }
-
-    /// Adds what a CG solve on coefficient c cost beyond a direct solve ([`Solver::Auto`]).
-    pub(super) fn pay_rent(&mut self, c: f64, seconds: f64) {
-        self.cg_seconds += seconds;
-        let seconds = (seconds - self.direct_seconds).max(0.0);
-        if let Some(r) = self.rent.iter_mut().find(|(k, _)| Self::same(*k, c)) {
-            r.1 += seconds;
-            return;
-        }
-        if self.rent.len() == RENT_SLOTS {
-            self.rent.remove(0);
-        }
-        self.rent.push((c, seconds));
     }
 
     /// Solves `(cM + A) x = rhs`: the answer replaces `rhs`; `guess` starts CG.
@@ -290,7 +334,7 @@ impl Implicit<'_> {
             let started = Instant::now();
             let its = self.pcg(c, guess)?;
             let seconds = started.elapsed().as_secs_f64();
-            self.pay_rent(c, seconds);
+            self.ledger.pay(c, its);
             self.stats.cg_iterations += its;
             self.stats.cg_solves += 1;
             self.stats.solves += 1;
@@ -325,8 +369,7 @@ impl Implicit<'_> {
             }
         }
         self.stats.solves += 1;
-        self.direct_seconds = started.elapsed().as_secs_f64();
-        self.stats.solve_seconds += self.direct_seconds;
+        self.stats.solve_seconds += started.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -383,5 +426,31 @@ impl Implicit<'_> {
         }
         self.rhs.copy_from_slice(x);
         Ok(its)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A dense SPD pattern of n unknowns factorises in n³/6 + O(n²) multiply-adds, whichever
+    /// structure (supernodal or simplicial) faer chooses.
+    #[test]
+    fn a_dense_factor_costs_a_sixth_of_n_cubed() {
+        let n = 60;
+        let offsets: Vec<usize> = (0..=n).map(|c| c * n).collect();
+        let rows: Vec<usize> = (0..n * n).map(|e| e % n).collect();
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &offsets, None, &rows);
+        let s = factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            SymmetricOrdering::Identity,
+            Default::default(),
+        )
+        .unwrap();
+        let cube = (n * n * n) as f64 / 6.0;
+        let got = factor_multiply_adds(&s);
+        // the O(n²) terms are n²/2 + n: within 10 % of n³/6 at n = 60
+        assert!((got - cube).abs() <= 0.1 * cube, "{got} against {cube}");
     }
 }

@@ -63,7 +63,7 @@ use faer::dyn_stack::MemBuffer;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::sparse::linalg::lu::SymbolicLu;
 use faer::Par;
-use linear::{Factor, RENT_SLOTS};
+use linear::{Factor, Ledger};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -135,14 +135,8 @@ pub struct Implicit<'a> {
     d_next: Vec<f64>,
     pred: Vec<f64>,
     hist: Vec<f64>,
-    /// [`Solver::Auto`]: CG seconds spent per coefficient c not factorised.
-    rent: Vec<(f64, f64)>,
-    /// Seconds of the last numeric factorisation (0 before the first).
-    last_factor_seconds: f64,
-    /// Seconds of all CG solves.
-    cg_seconds: f64,
-    /// Seconds of the last direct solve (0 before the first).
-    direct_seconds: f64,
+    /// [`Solver::Auto`]: the work of CG, direct solves and factorisations.
+    ledger: Ledger,
     /// Error allowed to a CG solution, K (adaptive runs: [`CG_SHARE`] of the tolerance).
     cg_error: f64,
     /// Smallest heat capacity M_i, J/K.
@@ -178,6 +172,7 @@ impl<'a> Implicit<'a> {
             factor_entries: chol.as_ref().map_or(0, |s| s.len_val()),
             ..Default::default()
         };
+        let ledger = Ledger::new(&sys, chol.as_ref());
         let mut scratch = vec![0.0; model.cloud.len()];
         for &i in &sys.free {
             scratch[i] = 0.0;
@@ -207,10 +202,7 @@ impl<'a> Implicit<'a> {
             d_next: Vec::new(),
             pred: Vec::new(),
             hist: Vec::new(),
-            rent: Vec::with_capacity(RENT_SLOTS),
-            last_factor_seconds: 0.0,
-            cg_seconds: 0.0,
-            direct_seconds: 0.0,
+            ledger,
             cg_error: 0.0,
             min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,
