@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::limits::MAX_STEPS;
 use crate::model::{Geometry, Model};
 use crate::solve::exchange::{Collective, RankPlan, Reduce};
-use crate::solve::implicit::Adaptive;
+use crate::solve::implicit::{symmetric_over, Adaptive};
 use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
 
 /// Settings of a run that are not part of the case.
@@ -126,14 +126,16 @@ fn no_lonely(model: &Model, count: usize, first: Option<usize>) -> Result<()> {
 }
 
 /// Whether `case` runs distributed with each rank building its share of the model
-/// ([`Model::build_share`]): a shareable model stepped explicitly at a fixed step.
+/// ([`Model::build_share`]): a shareable model stepped at a fixed step (explicit, implicit or
+/// steady; adaptive runs step the whole model on every rank).
 pub fn shares(case: &Case) -> bool {
-    Model::shareable(&case.spec) && !case.integrator.is_implicit() && case.tolerance.is_none()
+    Model::shareable(&case.spec) && case.tolerance.is_none()
 }
 
 /// One rank's model and plan in a distributed run over `link`: its share of the model when
 /// [`shares`] allows it (the budget per rank, the checks reduced over the ranks, the stable
-/// bound of every rank's rows), else the whole model with every rank's plan computed alike.
+/// bound of every rank's rows) and, for an implicit run, its system is symmetric over the
+/// ranks; else the whole model with every rank's plan computed alike.
 /// Every rank fails alike: what differs between ranks is reduced first.
 pub fn build_rank(
     case: &Case,
@@ -158,6 +160,13 @@ pub fn build_rank(
     semantic_share(case, &model, count, first).map_err(|e| keyed(case, e))?;
     let lambda = link.reduce(model.lambda_max(), Reduce::Max);
     model.set_lambda_max(lambda);
+    let implicit = case.integrator.is_implicit();
+    if implicit && !symmetric_over(&model, link).map_err(|e| keyed(case, e))? {
+        // distributed CG needs a symmetric system: every rank steps the whole model instead
+        let model = build(case, options)?;
+        let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
+        return Ok((model, plan));
+    }
     let plan = RankPlan::of_share(&model, partition, link);
     Ok((model, plan))
 }

@@ -70,8 +70,9 @@ pub struct Rank<'a> {
 /// [`crate::prepare::build_rank`]) as one rank of a distributed run over `exchange`:
 /// explicit runs, phase change included, step their rows only
 /// ([`crate::solve::explicit::Explicit::distribute`],
-/// [`crate::solve::enthalpy::Enthalpic::distribute`]); the implicit steppers step the whole
-/// model on every rank. Rank 0 writes `out` as a serial run
+/// [`crate::solve::enthalpy::Enthalpic::distribute`], and for fixed-step implicit and steady
+/// runs with a symmetric system [`crate::solve::implicit::Implicit::distribute`]); adaptive
+/// and asymmetric implicit runs step the whole model on every rank. Rank 0 writes `out` as a serial run
 /// would, with the same bits, and returns the summary; the other ranks return None. A rank
 /// that fails stops all of them.
 pub fn run_ranked<'a>(
@@ -83,6 +84,7 @@ pub fn run_ranked<'a>(
     progress: impl FnMut(u64, u64),
 ) -> Result<Option<RunSummary>> {
     let mut plan = plan(case, model)?;
+    let adaptive = plan.adaptive.is_some();
     let mode = match &mut plan.engine {
         Engine::Explicit(e) => {
             e.distribute(exchange);
@@ -91,6 +93,21 @@ pub fn run_ranked<'a>(
         Engine::Enthalpic(e) => {
             e.distribute(exchange);
             "rows"
+        }
+        Engine::Implicit(e) if !adaptive => {
+            if e.distribute(exchange).map_err(|e| keyed(case, e))? {
+                "rows"
+            } else if model.rows != (0..model.cloud.n_body) {
+                return Err(case.error(
+                    "time.integrator",
+                    format!(
+                        "a distributed implicit run needs a symmetric system, and this one is asymmetric to {:.1e} (interpolated mirror images or flux relations): run it on one rank, or with euler or rk4",
+                        e.system().asymmetry
+                    ),
+                ));
+            } else {
+                "replicated"
+            }
         }
         Engine::Implicit(_) => "replicated",
     };

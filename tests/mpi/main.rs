@@ -3,7 +3,9 @@
 //! Open MPI 4.1 too). Each run is launched as
 //! `mpiexec -n N peritherm run ...` for N = 1, 2 and 3 (3 oversubscribes a 2-core machine),
 //! asserts the communicator size it ran on (run.json `ranks.size`) and compares its fields
-//! with a serial run of the same binary on one thread, byte for byte.
+//! with a serial run of the same binary on one thread: byte for byte, except the fixed-step
+//! implicit runs that step by rows, whose distributed CG agrees with the serial direct solve
+//! to [`IMPLICIT_AGREEMENT`].
 //!
 //! The in-process ranks of `tests/cases/distributed.rs` check every bundled case with the same
 //! protocol without MPI; `scripts/mpi-check.sh` runs every bundled case under `mpiexec`.
@@ -16,7 +18,7 @@ mod common {
 }
 
 use common::cli::{command, EXE};
-use common::runs::same_field_files;
+use common::runs::{field_files_differ_by, same_field_files};
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -78,6 +80,11 @@ fn short(case: &Path) -> Vec<String> {
     set
 }
 
+/// Relative agreement of a distributed fixed-step implicit run with the serial one (per
+/// quantity, of its largest magnitude): the 1e-12 the issue allows. Its CG stops at 1e-15
+/// relative residual; the serial run factorises.
+const IMPLICIT_AGREEMENT: f64 = 1e-12;
+
 /// Runs `case` shortened serially on one thread into `dir/serial`, then under `mpiexec -n
 /// 1, 2, 3` into `dir/ranks-N`, and compares.
 fn same_under_mpiexec(case: &str) {
@@ -131,7 +138,16 @@ fn same_under_mpiexec(case: &str) {
             "{case}"
         );
         let what = format!("{case} on {ranks} ranks ({}, {setup})", r.mode);
-        same_field_files(&serial, &out, &fields, &what);
+        let implicit_rows = r.mode == "rows" && s.implicit.is_some();
+        if implicit_rows {
+            let d = field_files_differ_by(&serial, &out, &fields);
+            assert!(
+                d <= IMPLICIT_AGREEMENT,
+                "{what}: the fields differ by {d:e}"
+            );
+        } else {
+            same_field_files(&serial, &out, &fields, &what);
+        }
         planned_as_run(&path, ranks, &r, &what);
     }
 }
@@ -197,13 +213,15 @@ fn explicit_cases_give_the_serial_bits() {
 #[test]
 fn phase_change_and_implicit_steppers_give_the_serial_bits() {
     // phase change (the enthalpy stepper steps each rank's rows, ghost enthalpies exchanged),
-    // in a plane and axisymmetric; an implicit scheme and an adaptive one (every rank steps the
-    // whole model; the adaptive solver's choice between CG and a factorisation counts work,
-    // not seconds, so every rank and the serial run take the same path)
+    // in a plane and axisymmetric; implicit schemes at a fixed step (by rows, block-Jacobi
+    // CG) and adaptive (every rank steps the whole model; the adaptive solver's choice
+    // between CG and a factorisation counts work, not seconds, so every rank and the serial
+    // run take the same path)
     for case in [
         "ice_in_water.toml",
         "pipe_freezing.toml",
         "thermal_shock_k1_m1_implicit.toml",
+        "dh_crack_plate_k1_m1_implicit.toml",
         "dh_crack_plate_k1_m1_adaptive.toml",
     ] {
         same_under_mpiexec(case);

@@ -330,6 +330,15 @@ impl Implicit<'_> {
 
     /// Solves `(cM + A) x = rhs`: the answer replaces `rhs`; `guess` starts CG.
     pub(super) fn solve(&mut self, c: f64, guess: Guess) -> Result<()> {
+        if self.ranks.is_some() {
+            let started = Instant::now();
+            let its = self.distributed_pcg(c, guess)?;
+            self.stats.cg_iterations += its;
+            self.stats.cg_solves += 1;
+            self.stats.solves += 1;
+            self.stats.solve_seconds += started.elapsed().as_secs_f64();
+            return Ok(());
+        }
         if self.use_cg(c) {
             let started = Instant::now();
             let its = self.pcg(c, guess)?;

@@ -45,6 +45,7 @@
 
 mod adaptive;
 mod dense;
+mod distributed;
 mod linear;
 mod ordering;
 mod schemes;
@@ -52,6 +53,7 @@ mod steady;
 mod system;
 
 pub use adaptive::Adaptive;
+pub use distributed::{symmetric_over, DISTRIBUTED_CG_TOLERANCE};
 pub use linear::{LinearError, Options, Solver};
 pub use ordering::{nested_dissection, Ordering};
 pub use schemes::Scheme;
@@ -137,6 +139,8 @@ pub struct Implicit<'a> {
     hist: Vec<f64>,
     /// [`Solver::Auto`]: the work of CG, direct solves and factorisations.
     ledger: Ledger,
+    /// A distributed run's halo and block preconditioner ([`Implicit::distribute`]).
+    ranks: Option<distributed::Ranks<'a>>,
     /// Error allowed to a CG solution, K (adaptive runs: [`CG_SHARE`] of the tolerance).
     cg_error: f64,
     /// Smallest heat capacity M_i, J/K.
@@ -151,9 +155,14 @@ pub struct Implicit<'a> {
 
 impl<'a> Implicit<'a> {
     /// Builds the system (refusing what it cannot handle) and allocates the buffers.
-    pub fn new(model: &'a Model, scheme: Scheme, options: Options) -> Result<Self> {
+    pub fn new(model: &'a Model, scheme: Scheme, mut options: Options) -> Result<Self> {
         let sys = System::build(model)?;
-        if options.solver == Solver::Cg && !sys.symmetric {
+        let share = sys.held != (0..sys.len());
+        if share {
+            // a rank's share steps distributed ([`Implicit::distribute`]), which checks the
+            // symmetry over the ranks and factorises its own block only
+            options.solver = Solver::Cg;
+        } else if options.solver == Solver::Cg && !sys.symmetric {
             return Err(refuse(format!(
                 "conjugate gradients need a symmetric system; A is asymmetric to {:.1e} (interpolated mirror stencils or flux relations): use the direct solver",
                 sys.asymmetry
@@ -203,6 +212,7 @@ impl<'a> Implicit<'a> {
             pred: Vec::new(),
             hist: Vec::new(),
             ledger,
+            ranks: None,
             cg_error: 0.0,
             min_mass: sys.mass.iter().fold(f64::INFINITY, |m: f64, &v| m.min(v)),
             stats,

@@ -34,7 +34,7 @@ impl Implicit<'_> {
     pub(super) fn be_step(&mut self, t1: f64, h: f64) -> Result<()> {
         let c = 1.0 / h;
         self.forcing_into_next(t1);
-        for r in 0..self.u.len() {
+        for r in self.own() {
             self.rhs[r] = c * self.sys.mass[r] * self.u[r] + self.f_next[r];
         }
         self.solve(c, Guess::U)?;
@@ -47,9 +47,10 @@ impl Implicit<'_> {
     pub(super) fn cn_step(&mut self, t1: f64, h: f64) -> Result<()> {
         let c = 2.0 / h;
         self.forcing_into_next(t1);
+        Self::halo_of(&mut self.ranks, &self.sys, &mut self.u);
         self.sys
             .combine(c, 1.0, &self.u, &mut self.rhs, self.options.parallel);
-        for r in 0..self.u.len() {
+        for r in self.own() {
             self.rhs[r] += self.f_now[r] + self.f_next[r];
         }
         self.solve(c, Guess::U)?;
@@ -65,7 +66,7 @@ impl Implicit<'_> {
         let a1 = 1.0 + omega;
         let a2 = omega * omega / (1.0 + omega);
         self.forcing_into_next(t1);
-        for r in 0..self.u.len() {
+        for r in self.own() {
             self.rhs[r] =
                 self.sys.mass[r] / h * (a1 * self.u[r] - a2 * self.u_prev[r]) + self.f_next[r];
         }
@@ -90,12 +91,20 @@ impl Implicit<'_> {
         );
     }
 
-    /// Writes the unknowns into `theta` and sets every constrained node at time t.
+    /// Writes the unknowns into `theta` and sets every constrained node at time t; a
+    /// distributed run's ranks then gather the whole field.
     pub(super) fn scatter(&self, theta: &mut [f64], t: f64) -> Result<()> {
-        for (&u, &i) in self.u.iter().zip(&self.sys.free) {
-            theta[i] = u;
+        for k in self.own() {
+            theta[self.sys.free[k]] = self.u[k];
+        }
+        let ranks = self.ranks.as_ref().map(|r| r.exchange());
+        if let Some(ex) = ranks {
+            ex.halo(theta);
         }
         self.model.boundary.apply(&self.model.cloud, theta, t);
+        if let Some(ex) = ranks {
+            ex.all_gather(theta);
+        }
         check_finite(theta, self.model.cloud.n_body, t)
     }
 

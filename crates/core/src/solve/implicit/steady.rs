@@ -4,6 +4,7 @@ use super::linear::Guess;
 use super::{refuse, Implicit};
 use crate::error::Result;
 use crate::operator::Conductance;
+use crate::solve::exchange::Reduce;
 use crate::solve::stepper::RunStats;
 
 impl Implicit<'_> {
@@ -15,7 +16,14 @@ impl Implicit<'_> {
         outputs: &[f64],
         mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
     ) -> Result<RunStats> {
-        if self.sys.is_floating() {
+        let floating = match &self.ranks {
+            Some(r) => {
+                let here = if self.sys.is_floating() { 1.0 } else { 0.0 };
+                r.exchange().reduce(here, Reduce::Min) == 1.0
+            }
+            None => self.sys.is_floating(),
+        };
+        if floating {
             return Err(refuse(
                 "steady: no boundary condition fixes the temperature level (every face insulated or free, no temperature or convection condition); the steady state is not unique",
             ));

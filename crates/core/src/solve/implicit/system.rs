@@ -5,6 +5,7 @@ use super::refuse;
 use crate::error::Result;
 use crate::model::Model;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Relative asymmetry below which A is treated as symmetric (of the largest diagonal entry).
 pub const SYMMETRY_TOLERANCE: f64 = 1e-10;
@@ -28,6 +29,9 @@ pub struct System {
     pub asymmetry: f64,
     /// True when `asymmetry` ≤ [`SYMMETRY_TOLERANCE`].
     pub symmetric: bool,
+    /// The unknowns whose rows are held: all, or those of a share's rows
+    /// ([`crate::model::Model::rows`]; the others hold their diagonal M_i·h_i only).
+    pub held: Range<usize>,
     /// Row offsets of the coupling to constrained nodes (CSR over the unknowns).
     c_offsets: Vec<usize>,
     /// Constrained node of each coupling entry.
@@ -138,7 +142,10 @@ impl System {
             .iter()
             .map(|&i| model.cloud.volume[i] * model.capacity[i])
             .collect();
+        let held = free.partition_point(|&i| i < model.rows.start)
+            ..free.partition_point(|&i| i < model.rows.end);
         let mut sys = System {
+            held,
             free,
             offsets: Vec::with_capacity(n + 1),
             cols: Vec::with_capacity(k.nnz()),
@@ -216,22 +223,47 @@ impl System {
     }
 
     /// Sets [`System::asymmetry`] (relative to the largest diagonal entry) and
-    /// [`System::symmetric`].
+    /// [`System::symmetric`] from the pairs of held rows (a share's pairs with other ranks'
+    /// rows are compared by [`super::distributed`]).
     fn measure_symmetry(&mut self) {
-        let scale = self
-            .diag_pos
-            .iter()
-            .map(|&p| self.vals[p].abs())
-            .fold(0.0, f64::max);
+        let scale = self.diagonal_max(&self.held);
         let mut asym: f64 = 0.0;
-        for r in 0..self.len() {
+        for r in self.held.clone() {
             for e in self.offsets[r]..self.offsets[r + 1] {
                 let c = self.cols[e];
-                asym = asym.max((self.vals[e] - self.get(c, r)).abs());
+                if self.held.contains(&c) {
+                    asym = asym.max((self.vals[e] - self.get(c, r)).abs());
+                }
             }
         }
         self.asymmetry = if scale > 0.0 { asym / scale } else { 0.0 };
         self.symmetric = self.asymmetry <= SYMMETRY_TOLERANCE;
+    }
+
+    /// A system without unknowns, to be filled.
+    pub(super) fn empty() -> System {
+        System {
+            free: Vec::new(),
+            offsets: Vec::new(),
+            cols: Vec::new(),
+            vals: Vec::new(),
+            diag_pos: Vec::new(),
+            mass: Vec::new(),
+            asymmetry: 0.0,
+            symmetric: true,
+            held: 0..0,
+            c_offsets: Vec::new(),
+            c_cols: Vec::new(),
+            c_vals: Vec::new(),
+        }
+    }
+
+    /// The largest |A_rr| over the rows `rows`, W/K.
+    pub(super) fn diagonal_max(&self, rows: &Range<usize>) -> f64 {
+        self.diag_pos[rows.clone()]
+            .iter()
+            .map(|&p| self.vals[p].abs())
+            .fold(0.0, f64::max)
     }
 
     /// Number of unknowns (free body nodes).
@@ -254,15 +286,15 @@ impl System {
     }
 
     /// True when the constant field is in the null space of A (no boundary fixes the level):
-    /// every row sum below 1e-9 of its diagonal entry.
+    /// every held row sum below 1e-9 of its diagonal entry.
     pub fn is_floating(&self) -> bool {
-        (0..self.len()).all(|r| {
+        self.held.clone().all(|r| {
             let s: f64 = self.vals[self.offsets[r]..self.offsets[r + 1]].iter().sum();
             s.abs() <= 1e-9 * self.vals[self.diag_pos[r]].abs()
         })
     }
 
-    /// `out = c·M·u − a·A·u` (W), in parallel when asked.
+    /// `out = c·M·u − a·A·u` (W) on the held rows, in parallel when asked.
     pub(super) fn combine(&self, c: f64, a: f64, u: &[f64], out: &mut [f64], parallel: bool) {
         let row = |r: usize| {
             let mut s = 0.0;
@@ -271,14 +303,16 @@ impl System {
             }
             c * self.mass[r] * u[r] - a * s
         };
+        let held = self.held.clone();
+        let out = &mut out[held.clone()];
         if parallel {
             out.par_iter_mut()
                 .with_min_len(1024)
                 .enumerate()
-                .for_each(|(r, o)| *o = row(r));
+                .for_each(|(k, o)| *o = row(held.start + k));
         } else {
-            for (r, o) in out.iter_mut().enumerate() {
-                *o = row(r);
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = row(held.start + k);
             }
         }
     }
