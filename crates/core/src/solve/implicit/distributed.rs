@@ -214,7 +214,12 @@ impl<'a> Implicit<'a> {
         let own = self.own();
         let par = self.par;
         let ranks = self.ranks.as_mut().expect("a distributed stepper");
-        let slot = ranks.factor(c, par)?;
+        let started = std::time::Instant::now();
+        let (slot, new) = ranks.factor(c, par)?;
+        if new {
+            self.stats.factorisations += 1;
+            self.stats.factor_seconds += started.elapsed().as_secs_f64();
+        }
         let z = &mut z[own.clone()];
         z.copy_from_slice(&r[own]);
         let n = z.len();
@@ -234,10 +239,11 @@ impl<'a> Ranks<'a> {
         self.exchange
     }
 
-    /// The slot of the block's factor of cM + A, factorised now if not cached.
-    fn factor(&mut self, c: f64, par: Par) -> Result<usize> {
+    /// The slot of the block's factor of cM + A, and whether it was factorised now (not
+    /// cached).
+    fn factor(&mut self, c: f64, par: Par) -> Result<(usize, bool)> {
         if let Some(p) = self.factors.iter().position(|(k, _)| Implicit::same(*k, c)) {
-            return Ok(p);
+            return Ok((p, false));
         }
         let b = &self.block;
         let mut vals = b.vals.clone();
@@ -269,7 +275,7 @@ impl<'a> Ranks<'a> {
             self.factors.remove(0);
         }
         self.factors.push((c, values));
-        Ok(self.factors.len() - 1)
+        Ok((self.factors.len() - 1, true))
     }
 }
 
