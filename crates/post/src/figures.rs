@@ -16,10 +16,11 @@ pub const DIR: &str = "validation";
 /// shortest round-trip printing.
 pub const REL_TOL_EXACT: f64 = 1e-12;
 
-/// Relative tolerance of a measure of an implicit, adaptive or steady run: two runs of the same
-/// case may pick the conjugate-gradient or the direct solver from measured timings, which moves
-/// the fields by about 1e-10 K (docs/performance.md), so a figure may move by that much against
-/// differences as small as 1e-6 K.
+/// Relative tolerance of a measure of an implicit, adaptive or steady run: the sparse
+/// factorisations (faer) split their work by the thread count, so a rerun on another machine
+/// or thread count may move the fields in their last bits, and an adaptive run's accepted
+/// steps with them; a figure that is a small difference (1e-6 K against a field of 100 K)
+/// may then move by far more than the fields' round-off.
 pub const REL_TOL_SOLVER: f64 = 1e-4;
 
 /// A table of measured figures and how to check them again.
