@@ -56,10 +56,10 @@ pub(super) struct Ranks<'a> {
 
 impl<'a> Implicit<'a> {
     /// Makes this stepper one rank of a distributed run over `exchange`: it steps the unknowns
-    /// of the rank's rows and solves by distributed block-Jacobi CG. Returns false, changing
-    /// nothing, when A is not symmetric over the ranks (then every rank must step the whole
-    /// model, which needs the whole model: see [`crate::model::Model::rows`]) or when there
-    /// is one rank. Collective.
+    /// of the rank's rows and solves by distributed block-Jacobi CG. Returns false when there
+    /// is one rank, and when A is not symmetric over the ranks (its asymmetry is then the one
+    /// measured over all ranks; every rank must step the whole model, which needs the whole
+    /// model: see [`crate::model::Model::rows`]). Collective.
     pub fn distribute(&mut self, exchange: &'a dyn Exchange) -> Result<bool> {
         if exchange.size() == 1 {
             // one rank holds the whole model: the serial solvers serve it best
