@@ -25,7 +25,7 @@ use std::ops::Range;
 /// Relative residual ‖b − Bx‖₂/‖b‖₂ at which a distributed CG solve stops: round-off, so that
 /// a distributed run agrees with a serial direct solve to about 1e-12 relative. Where
 /// round-off keeps the residual above it, the solve stops once the residual has not fallen
-/// for [`STALL`] iterations.
+/// for 8 iterations.
 pub const DISTRIBUTED_CG_TOLERANCE: f64 = 1e-15;
 
 /// Iterations without a smaller residual after which a distributed CG solve has reached
@@ -280,7 +280,8 @@ impl<'a> Ranks<'a> {
 }
 
 /// Whether the implicit system of `model`, one rank's share of `link`'s ranks, is symmetric
-/// over all ranks ([`cross_asymmetry`]), so that [`Implicit::distribute`] can solve it.
+/// over all ranks (each rank's entries towards another's compared with that rank's
+/// transposed ones), so that [`Implicit::distribute`] can solve it.
 /// Collective.
 pub fn symmetric_over(model: &Model, link: &dyn Collective) -> Result<bool> {
     let sys = System::build(model)?;
