@@ -143,9 +143,7 @@ pub fn build_rank(
     link: &dyn Collective,
 ) -> Result<(Model, RankPlan)> {
     if !shares(case) {
-        let model = build(case, options)?;
-        let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
-        return Ok((model, plan));
+        return whole_rank(case, options, link);
     }
     case.budget
         .per_rank(link.size())
@@ -163,11 +161,16 @@ pub fn build_rank(
     let implicit = case.integrator.is_implicit();
     if implicit && !symmetric_over(&model, link).map_err(|e| keyed(case, e))? {
         // distributed CG needs a symmetric system: every rank steps the whole model instead
-        let model = build(case, options)?;
-        let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
-        return Ok((model, plan));
+        return whole_rank(case, options, link);
     }
     let plan = RankPlan::of_share(&model, partition, link);
+    Ok((model, plan))
+}
+
+/// The whole model on this rank, with its plan computed as every rank computes it.
+fn whole_rank(case: &Case, options: &Options, link: &dyn Collective) -> Result<(Model, RankPlan)> {
+    let model = build(case, options)?;
+    let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
     Ok((model, plan))
 }
 

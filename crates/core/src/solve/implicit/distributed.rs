@@ -8,17 +8,16 @@
 //! [`cross_asymmetry`] at set-up. It is iterated to [`DISTRIBUTED_CG_TOLERANCE`], close to
 //! round-off, so that the fields agree with a serial direct solve to about 1e-12 relative.
 
-use super::linear::{Guess, LinearError};
+use super::linear::{keep, llt_values, shifted_into, slot_of, Guess, LinearError};
 use super::{Implicit, System};
 use crate::error::Result;
 use crate::model::Model;
 use crate::solve::exchange::{swap_values, Collective, Exchange, Reduce};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::SymbolicSparseColMatRef;
 use faer::{Conj, MatMut, Par, Side};
 use std::ops::Range;
 
@@ -69,7 +68,13 @@ impl<'a> Implicit<'a> {
         let free = &self.sys.free;
         let own =
             free.partition_point(|&i| i < rows.start)..free.partition_point(|&i| i < rows.end);
-        let asymmetry = cross_asymmetry(&self.sys, &own, exchange);
+        // a whole model's system measured every pair already; a share's compares with the
+        // other ranks' rows
+        let whole = self.sys.held == (0..self.sys.len());
+        let asymmetry = match whole {
+            true => self.sys.asymmetry,
+            false => cross_asymmetry(&self.sys, &own, exchange),
+        };
         if asymmetry > super::SYMMETRY_TOLERANCE {
             self.sys.asymmetry = asymmetry;
             self.sys.symmetric = false;
@@ -242,40 +247,13 @@ impl<'a> Ranks<'a> {
     /// The slot of the block's factor of cM + A, and whether it was factorised now (not
     /// cached).
     fn factor(&mut self, c: f64, par: Par) -> Result<(usize, bool)> {
-        if let Some(p) = self.factors.iter().position(|(k, _)| Implicit::same(*k, c)) {
+        if let Some(p) = slot_of(&self.factors, c) {
             return Ok((p, false));
         }
-        let b = &self.block;
-        let mut vals = b.vals.clone();
-        for (r, &p) in b.diag_pos.iter().enumerate() {
-            vals[p] += c * b.mass[r];
-        }
-        let n = b.len();
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &b.offsets, None, &b.cols);
-        let mut values = vec![0.0; self.symbolic.len_val()];
-        let req = self
-            .symbolic
-            .factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut mem = MemBuffer::new(req);
-        self.symbolic
-            .factorize_numeric_llt(
-                &mut values,
-                SparseColMatRef::new(pattern, &vals),
-                Side::Lower,
-                LltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| LinearError::Cholesky {
-                c,
-                detail: format!("{e:?}"),
-            })?;
-        if self.factors.len() == 2 {
-            self.factors.remove(0);
-        }
-        self.factors.push((c, values));
-        Ok((self.factors.len() - 1, true))
+        let mut vals = vec![0.0; self.block.vals.len()];
+        shifted_into(&self.block, c, &mut vals);
+        let values = llt_values(&self.symbolic, &self.block, &vals, c, par)?;
+        Ok((keep(&mut self.factors, c, values), true))
     }
 }
 

@@ -248,46 +248,79 @@ pub(super) fn factor_multiply_adds(s: &SymbolicCholesky<usize>) -> f64 {
     }
 }
 
+/// The values of `cM + A` of `sys` into `vals`: A's entries with c·M_i added on the
+/// diagonal, W/K.
+pub(super) fn shifted_into(sys: &System, c: f64, vals: &mut [f64]) {
+    vals.copy_from_slice(&sys.vals);
+    for (r, &p) in sys.diag_pos.iter().enumerate() {
+        vals[p] += c * sys.mass[r];
+    }
+}
+
+/// The numeric Cholesky factor, with the symbolic structure `s`, of the matrix with the CSR
+/// arrays of `sys` (symmetric: they are its CSC arrays too) and the values `vals` = cM + A.
+pub(super) fn llt_values(
+    s: &SymbolicCholesky<usize>,
+    sys: &System,
+    vals: &[f64],
+    c: f64,
+    par: Par,
+) -> Result<Vec<f64>> {
+    let n = sys.len();
+    let pattern = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
+    let mut values = vec![0.0; s.len_val()];
+    let req = s.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+    let mut mem = MemBuffer::new(req);
+    s.factorize_numeric_llt(
+        &mut values,
+        SparseColMatRef::new(pattern, vals),
+        Side::Lower,
+        LltRegularization::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .map_err(|e| LinearError::Cholesky {
+        c,
+        detail: format!("{e:?}"),
+    })?;
+    Ok(values)
+}
+
+/// The slot of the factor of coefficient `c` among `slots`, if cached.
+pub(super) fn slot_of<T>(slots: &[(f64, T)], c: f64) -> Option<usize> {
+    slots.iter().position(|(k, _)| Implicit::same(*k, c))
+}
+
+/// Caches `factor` of coefficient `c` in `slots`, which keep the two latest; returns its slot.
+pub(super) fn keep<T>(slots: &mut Vec<(f64, T)>, c: f64, factor: T) -> usize {
+    if slots.len() == 2 {
+        slots.remove(0);
+    }
+    slots.push((c, factor));
+    slots.len() - 1
+}
+
 impl Implicit<'_> {
     /// Makes sure a factorisation of `cM + A` is cached; returns its slot.
     pub(super) fn factor(&mut self, c: f64) -> Result<usize> {
-        if let Some(p) = self.factors.iter().position(|(k, _)| Self::same(*k, c)) {
+        if let Some(p) = slot_of(&self.factors, c) {
             return Ok(p);
         }
         let started = Instant::now();
         let sys = &self.sys;
-        self.b_vals.copy_from_slice(&sys.vals);
-        for (r, &p) in sys.diag_pos.iter().enumerate() {
-            self.b_vals[p] += c * sys.mass[r];
-        }
-        let n = sys.len();
-        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
-        let b = SparseColMatRef::new(symbolic, &self.b_vals);
+        shifted_into(sys, c, &mut self.b_vals);
         let factor = if let Some(s) = &self.chol {
-            let mut values = vec![0.0; s.len_val()];
-            let req = s.factorize_numeric_llt_scratch::<f64>(self.par, Default::default());
-            let mut mem = MemBuffer::new(req);
-            s.factorize_numeric_llt(
-                &mut values,
-                b,
-                Side::Lower,
-                LltRegularization::default(),
-                self.par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| LinearError::Cholesky {
-                c,
-                detail: format!("{e:?}"),
-            })?;
-            Factor::Llt(values)
+            Factor::Llt(llt_values(s, sys, &self.b_vals, c, self.par)?)
         } else if let Some(s) = &self.lu {
+            let n = sys.len();
+            let pattern = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
             let mut numeric = NumericLu::<usize, f64>::new();
             let req = s.factorize_numeric_lu_scratch::<f64>(self.par, Default::default());
             let mut mem = MemBuffer::new(req);
             s.factorize_numeric_lu(
                 &mut numeric,
-                b,
+                SparseColMatRef::new(pattern, &self.b_vals),
                 self.par,
                 MemStack::new(&mut mem),
                 Default::default(),
@@ -300,13 +333,10 @@ impl Implicit<'_> {
         } else {
             return Err(LinearError::NoSymbolic.into());
         };
-        if self.factors.len() == 2 {
-            self.factors.remove(0);
-        }
-        self.factors.push((c, factor));
+        let slot = keep(&mut self.factors, c, factor);
         self.stats.factorisations += 1;
         self.stats.factor_seconds += started.elapsed().as_secs_f64();
-        Ok(self.factors.len() - 1)
+        Ok(slot)
     }
 
     /// True when `c` matches `k` to 1e-12 relative.
@@ -330,24 +360,20 @@ impl Implicit<'_> {
 
     /// Solves `(cM + A) x = rhs`: the answer replaces `rhs`; `guess` starts CG.
     pub(super) fn solve(&mut self, c: f64, guess: Guess) -> Result<()> {
-        if self.ranks.is_some() {
+        let distributed = self.ranks.is_some();
+        if distributed || self.use_cg(c) {
             let started = Instant::now();
-            let its = self.distributed_pcg(c, guess)?;
+            let its = if distributed {
+                self.distributed_pcg(c, guess)?
+            } else {
+                let its = self.pcg(c, guess)?;
+                self.ledger.pay(c, its);
+                its
+            };
             self.stats.cg_iterations += its;
             self.stats.cg_solves += 1;
             self.stats.solves += 1;
             self.stats.solve_seconds += started.elapsed().as_secs_f64();
-            return Ok(());
-        }
-        if self.use_cg(c) {
-            let started = Instant::now();
-            let its = self.pcg(c, guess)?;
-            let seconds = started.elapsed().as_secs_f64();
-            self.ledger.pay(c, its);
-            self.stats.cg_iterations += its;
-            self.stats.cg_solves += 1;
-            self.stats.solves += 1;
-            self.stats.solve_seconds += seconds;
             return Ok(());
         }
         let slot = self.factor(c)?;
