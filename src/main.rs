@@ -122,6 +122,10 @@ enum Command {
         /// default when every case has one; otherwise the first variant).
         #[arg(long, value_name = "RUN_DIR")]
         against: Option<PathBuf>,
+        /// Compare with the first variant's fields even when the cases have their own
+        /// [reference] (e.g. a refined mesh against the uniform fine run named first).
+        #[arg(long, conflicts_with = "against")]
+        against_first: bool,
         /// Leave out the nodes within this distance (m) of a crack tip in field comparisons.
         #[arg(long, value_name = "RADIUS", default_value_t = 0.0)]
         exclude_tips: f64,
@@ -320,11 +324,16 @@ fn dispatch(
             vary,
             out,
             against,
+            against_first,
             exclude_tips,
             json,
             command,
         } => {
             let figures = json.map(|path| (path, command));
+            let against = match against {
+                Some(dir) => Some(peritherm::sweep::Against::Run(dir)),
+                None => against_first.then_some(peritherm::sweep::Against::First),
+            };
             sweep(&cases, &vary, &out, against, exclude_tips, figures)
         }
         Command::Bench {
@@ -772,14 +781,15 @@ fn sweep(
     cases: &[PathBuf],
     vary: &[peritherm::sweep::Vary],
     out: &std::path::Path,
-    against: Option<PathBuf>,
+    against: Option<peritherm::sweep::Against>,
     exclude_tips: f64,
     figures: Option<(PathBuf, String)>,
 ) -> anyhow::Result<()> {
     use peritherm::sweep;
-    let args = against
-        .is_none()
-        .then(|| sweep_args(cases, vary, exclude_tips));
+    // a sweep against a run directory cannot be repeated by its arguments alone
+    let first = against == Some(sweep::Against::First);
+    let args = (!matches!(against, Some(sweep::Against::Run(_))))
+        .then(|| sweep_args(cases, vary, first, exclude_tips));
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         anyhow::bail!("--exclude-tips: must be a distance >= 0 m, got {exclude_tips}");
     }
@@ -805,12 +815,16 @@ fn sweep(
 fn sweep_args(
     cases: &[PathBuf],
     vary: &[peritherm::sweep::Vary],
+    against_first: bool,
     exclude_tips: f64,
 ) -> Vec<String> {
     let mut args = vec!["sweep".to_string()];
     args.extend(cases.iter().map(|c| c.display().to_string()));
     for v in vary {
         args.extend(["--vary".into(), format!("{}={}", v.key, v.values.join(","))]);
+    }
+    if against_first {
+        args.push("--against-first".into());
     }
     if exclude_tips > 0.0 {
         args.extend(["--exclude-tips".into(), exclude_tips.to_string()]);

@@ -456,7 +456,7 @@ struct VariantRun<'a> {
 }
 
 impl<'a> VariantRun<'a> {
-    /// Runs `v` into `dir`; compared with another run, a variant's own [reference.fem]
+    /// Runs `v` into `dir`; compared with a run (another or the first), a variant's own [reference.fem]
     /// (solved again for every variant, the measures not using it) is left out.
     fn run(v: &'a Variant, dir: PathBuf, against: &Against) -> Result<VariantRun<'a>> {
         let own_fem = v
@@ -464,7 +464,7 @@ impl<'a> VariantRun<'a> {
             .reference
             .as_ref()
             .is_some_and(|r| matches!(r.source, ReferenceSource::Fem(_)));
-        let summary = if own_fem && matches!(against, Against::Run(_)) {
+        let summary = if own_fem && *against != Against::Reference {
             let mut case = v.case.clone();
             case.reference = None;
             run_case(&case, &dir, |_, _| {})?
@@ -872,13 +872,13 @@ impl LinesAt<'_> {
 }
 
 /// The variants of a study and what they are compared with: every file of `cases` swept over
-/// `vary` (labels prefixed with the file's stem when several files are compared), against the
-/// run directory `against`, else each variant's own reference when every variant has one, else
-/// the first variant. What `peritherm sweep` and the Python `sweep` run.
+/// `vary` (labels prefixed with the file's stem when several files are compared), compared as
+/// `against` says, else with each variant's own reference when every variant has one, else
+/// with the first variant. What `peritherm sweep` and the Python `sweep` run.
 pub fn study(
     cases: &[PathBuf],
     vary: &[Vary],
-    against: Option<PathBuf>,
+    against: Option<Against>,
 ) -> Result<(Vec<Variant>, Against)> {
     let mut all = Vec::new();
     for path in cases {
@@ -900,7 +900,7 @@ pub fn study(
         all.extend(v);
     }
     let against = match against {
-        Some(dir) => Against::Run(dir),
+        Some(a) => a,
         None if all.iter().all(|v| v.case.reference.is_some()) => Against::Reference,
         None => Against::First,
     };
