@@ -774,25 +774,36 @@ fn fem<'py>(
     summary_dict(py, &summary)
 }
 
-/// `peritherm sweep CASE... --vary KEY=V1,V2 --out OUT [--against RUN] [--exclude-tips R]`:
+/// `peritherm sweep CASE... --vary KEY=V1,V2 --out OUT [--against RUN | --against-first]
+/// [--exclude-tips R]`:
 /// the same variants, runs, comparisons, plots, sweep.csv and sweep.md. Returns a dict:
 /// `rows` (one dict per variant and output time, the columns of sweep.csv), `table` (the
 /// Markdown the CLI prints, with the fitted rates and plot links), `csv` (sweep.csv's text).
 /// GIL released; Ctrl-C is honoured between variants.
 #[pyfunction]
-#[pyo3(signature = (cases, out, vary = Vec::new(), against = None, exclude_tips = 0.0))]
+#[pyo3(signature = (cases, out, vary = Vec::new(), against = None, against_first = false, exclude_tips = 0.0))]
 fn sweep<'py>(
     py: Python<'py>,
     cases: Vec<PathBuf>,
     out: PathBuf,
     vary: Vec<String>,
     against: Option<PathBuf>,
+    against_first: bool,
     exclude_tips: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use peritherm::sweep::{self, Vary};
+    use peritherm::sweep::{self, Against, Vary};
     if cases.is_empty() {
         return Err(PyValueError::new_err("cases: give at least one case file"));
     }
+    if against.is_some() && against_first {
+        return Err(PyValueError::new_err(
+            "against, against_first: give one of them",
+        ));
+    }
+    let against = match against {
+        Some(dir) => Some(Against::Run(dir)),
+        None => against_first.then_some(Against::First),
+    };
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         return Err(PyValueError::new_err(format!(
             "exclude_tips: must be a distance >= 0 m, got {exclude_tips}"
@@ -806,7 +817,7 @@ fn sweep<'py>(
         })
         .collect::<PyResult<_>>()?;
     let (variants, against) =
-        sweep::study(&cases, &vary, against.map(sweep::Against::Run)).map_err(py_err)?;
+        sweep::study(&cases, &vary, against).map_err(py_err)?;
     let (rows, table, csv) = interruptible(py, |check| {
         let rows = sweep::run(&variants, &out, &against, exclude_tips, |_, _| check())?;
         let (table, csv) = sweep::write_study(&variants, &rows, &out, &against)?;
