@@ -816,8 +816,7 @@ fn sweep<'py>(
                 .map_err(|e| PyValueError::new_err(format!("vary: {e}")))
         })
         .collect::<PyResult<_>>()?;
-    let (variants, against) =
-        sweep::study(&cases, &vary, against).map_err(py_err)?;
+    let (variants, against) = sweep::study(&cases, &vary, against).map_err(py_err)?;
     let (rows, table, csv) = interruptible(py, |check| {
         let rows = sweep::run(&variants, &out, &against, exclude_tips, |_, _| check())?;
         let (table, csv) = sweep::write_study(&variants, &rows, &out, &against)?;
