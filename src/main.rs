@@ -330,10 +330,7 @@ fn dispatch(
             command,
         } => {
             let figures = json.map(|path| (path, command));
-            let against = match against {
-                Some(dir) => Some(peritherm::sweep::Against::Run(dir)),
-                None => against_first.then_some(peritherm::sweep::Against::First),
-            };
+            let against = peritherm::sweep::Against::chosen(against, against_first);
             sweep(&cases, &vary, &out, against, exclude_tips, figures)
         }
         Command::Bench {

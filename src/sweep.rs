@@ -416,6 +416,17 @@ pub enum Against {
     First,
 }
 
+impl Against {
+    /// What the options ask for: a run directory (`--against`), the first variant
+    /// (`--against-first`), or None to let [`study`] choose.
+    pub fn chosen(run: Option<PathBuf>, first: bool) -> Option<Against> {
+        match run {
+            Some(dir) => Some(Against::Run(dir)),
+            None => first.then_some(Against::First),
+        }
+    }
+}
+
 /// Runs every variant into `out/<label>/` and compares it with `against` at each of its
 /// output times; nodes within `exclude_tips` (m) of a crack tip are left out of field-to-field
 /// comparisons. `progress(k, label)` is called before variant k runs.
@@ -456,8 +467,8 @@ struct VariantRun<'a> {
 }
 
 impl<'a> VariantRun<'a> {
-    /// Runs `v` into `dir`; compared with a run (another or the first), a variant's own [reference.fem]
-    /// (solved again for every variant, the measures not using it) is left out.
+    /// Runs `v` into `dir`; compared with a run (another or the first), a variant's own
+    /// [reference.fem] (solved again for every variant, the measures not using it) is left out.
     fn run(v: &'a Variant, dir: PathBuf, against: &Against) -> Result<VariantRun<'a>> {
         let own_fem = v
             .case

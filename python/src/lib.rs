@@ -800,10 +800,7 @@ fn sweep<'py>(
             "against, against_first: give one of them",
         ));
     }
-    let against = match against {
-        Some(dir) => Some(Against::Run(dir)),
-        None => against_first.then_some(Against::First),
-    };
+    let against = Against::chosen(against, against_first);
     if !(exclude_tips.is_finite() && exclude_tips >= 0.0) {
         return Err(PyValueError::new_err(format!(
             "exclude_tips: must be a distance >= 0 m, got {exclude_tips}"

@@ -256,3 +256,19 @@ def test_dict_and_file_give_the_same_case():
     a = peritherm.Case.load(path)
     b = peritherm.Case.from_dict(d, path=path)
     assert (a.title, a.end, a.outputs, a.integrator) == (b.title, b.end, b.outputs, b.integrator)
+
+
+def test_sweep_against_first_compares_with_the_first_variant(tmp_path):
+    """`against_first=True` (`--against-first`) compares with the first variant although the
+    case has its own reference (the series): the first variant's row is zero, the second's is
+    not; giving it with `against` is a ValueError naming both."""
+    case = str(ROOT / "cases" / "bar_dirichlet.toml")
+    vary = ["region.*.horizon.radius=0.3,0.15", "time.outputs=[0.1]"]
+    r = peritherm.sweep([case], str(tmp_path / "s"), vary=vary, against_first=True)
+    rows = r["rows"]
+    assert len(rows) == 2
+    assert rows[0]["max_abs"] == 0.0 and rows[1]["max_abs"] > 1.0
+    assert all(row["against"].endswith(rows[0]["label"]) for row in rows)
+    with pytest.raises(ValueError, match="against, against_first"):
+        peritherm.sweep([case], str(tmp_path / "t"), vary=vary, against=str(tmp_path / "s"),
+                        against_first=True)

@@ -349,7 +349,8 @@ fn gmsh_cases_run_compare_and_refuse_bad_meshes() {
 /// Δ, to t = 0.1 s) writes one row per variant and output, and the max difference to the series
 /// falls as δ falls (the δ-convergence of Bobaru & Duangpanya 2010 Fig. 10, measured 31.2 → 15.2 →
 /// 5.3 °C at t = 0.1 s, where the steep initial layer makes the error large). Against the first
-/// variant instead, that variant's own row is zero.
+/// variant instead (its run directory, or `--against-first` although the case has a reference),
+/// that variant's own row is zero.
 #[test]
 fn sweep_writes_a_table_and_converges_in_delta() {
     let dir = tempfile::tempdir().unwrap();
@@ -403,6 +404,34 @@ fn sweep_writes_a_table_and_converges_in_delta() {
         .parse()
         .unwrap();
     assert!(first < 1e-12, "{csv}");
+    // the case has its own reference (the series); --against-first compares with the first
+    // variant instead: its rows are zero, the second's are not, and both name the first's run in sweep.md
+    let o = peritherm(&[
+        "sweep",
+        case.to_str().unwrap(),
+        "--vary",
+        "region.*.horizon.radius=0.3,0.15",
+        "--vary",
+        "time.outputs=[0.1]",
+        "--out",
+        dir.path().join("against-first").to_str().unwrap(),
+        "--against-first",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("against-first/sweep.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let diff = |r: &[&str]| r[10].parse::<f64>().unwrap();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert!(diff(&rows[0]) == 0.0 && diff(&rows[1]) > 1.0, "{csv}");
+    let md = std::fs::read_to_string(dir.path().join("against-first/sweep.md")).unwrap();
+    let against = md
+        .lines()
+        .filter(|l| l.ends_with("radius=0.3_outputs=_0.1_ |"));
+    assert_eq!(against.count(), 2, "{md}");
     let o = peritherm(&[
         "sweep",
         case.to_str().unwrap(),

@@ -55,8 +55,6 @@ fn open_mpi_flags() -> Vec<&'static str> {
     }
 }
 
-/// The settings that shorten a bundled case to a hundredth of its first output (as the
-/// fields figure does), three steps at least.
 /// Settings that keep a heavy set-up light where the test is about the ranks, not the weights:
 /// the uniform crack plate's quadratic weights take about a minute and 4.6 GB per process
 /// (every rank builds a corrected model whole); the linear order takes the same whole-model
@@ -65,6 +63,8 @@ fn light(case: &str) -> Option<String> {
     (case == "crack_plate_uniform.toml").then(|| "kernel.consistency=\"linear\"".to_string())
 }
 
+/// The settings that shorten a bundled case to a hundredth of its first output (as the
+/// fields figure does), three steps at least.
 fn short(case: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(case).unwrap();
     let table: toml::Table = text.parse().unwrap();
