@@ -354,79 +354,46 @@ fn gmsh_cases_run_compare_and_refuse_bad_meshes() {
 #[test]
 fn sweep_writes_a_table_and_converges_in_delta() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("sweep");
     let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bar_dirichlet.toml");
-    let o = peritherm(&[
-        "sweep",
-        case.to_str().unwrap(),
-        "--vary",
-        "region.*.horizon.radius=0.3,0.15,0.075",
-        "--vary",
-        "time.outputs=[0.1]",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
-    let lines: Vec<&str> = csv.lines().collect();
-    assert!(lines[0].starts_with("variant,region.*.horizon.radius,time.outputs,nodes"));
-    assert_eq!(lines.len(), 4, "{csv}");
-    let max_abs: Vec<f64> = lines[1..]
-        .iter()
-        .map(|l| l.split(',').nth(10).unwrap().parse().unwrap())
-        .collect();
-    assert!(
-        max_abs[0] > max_abs[1] && max_abs[1] > max_abs[2],
-        "{max_abs:?}"
+    // sweeps the bar's horizon radii to t = 0.1 s into dir/NAME; returns sweep.csv
+    let sweep = |radii: &str, name: &str, extra: &[&str]| -> String {
+        let out = dir.path().join(name);
+        let vary = format!("region.*.horizon.radius={radii}");
+        let mut args = vec!["sweep", case.to_str().unwrap(), "--vary", &vary];
+        args.extend([
+            "--vary",
+            "time.outputs=[0.1]",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        args.extend(extra);
+        let o = peritherm(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(out.join("sweep.csv")).unwrap()
+    };
+    // the max abs difference of every row (the 11th column with two varied keys)
+    let max_abs = |csv: &str| -> Vec<f64> {
+        let rows = csv.lines().skip(1);
+        rows.map(|l| l.split(',').nth(10).unwrap().parse().unwrap())
+            .collect()
+    };
+    let csv = sweep("0.3,0.15,0.075", "sweep", &[]);
+    assert!(csv.starts_with("variant,region.*.horizon.radius,time.outputs,nodes"));
+    let d = max_abs(&csv);
+    assert!(d.len() == 3 && d[0] > d[1] && d[1] > d[2], "{csv}");
+    let first_run = dir.path().join("sweep/radius=0.3_outputs=_0.1_");
+    assert!(first_run.join("run.json").exists());
+    let csv = sweep(
+        "0.3,0.15",
+        "first",
+        &["--against", first_run.to_str().unwrap()],
     );
-    assert!(out.join("radius=0.075_outputs=_0.1_/run.json").exists());
-    let o = peritherm(&[
-        "sweep",
-        case.to_str().unwrap(),
-        "--vary",
-        "region.*.horizon.radius=0.3,0.15",
-        "--vary",
-        "time.outputs=[0.1]",
-        "--out",
-        dir.path().join("first").to_str().unwrap(),
-        "--against",
-        out.join("radius=0.3_outputs=_0.1_").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(dir.path().join("first/sweep.csv")).unwrap();
-    let first: f64 = csv
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .nth(10)
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!(first < 1e-12, "{csv}");
+    assert!(max_abs(&csv)[0] < 1e-12, "{csv}");
     // the case has its own reference (the series); --against-first compares with the first
-    // variant instead: its rows are zero, the second's are not, and both name the first's run in sweep.md
-    let o = peritherm(&[
-        "sweep",
-        case.to_str().unwrap(),
-        "--vary",
-        "region.*.horizon.radius=0.3,0.15",
-        "--vary",
-        "time.outputs=[0.1]",
-        "--out",
-        dir.path().join("against-first").to_str().unwrap(),
-        "--against-first",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(dir.path().join("against-first/sweep.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
-    let diff = |r: &[&str]| r[10].parse::<f64>().unwrap();
-    assert_eq!(rows.len(), 2, "{csv}");
-    assert!(diff(&rows[0]) == 0.0 && diff(&rows[1]) > 1.0, "{csv}");
+    // variant instead: its row is zero, the second's is not, and both name the first's run
+    let csv = sweep("0.3,0.15", "against-first", &["--against-first"]);
+    let d = max_abs(&csv);
+    assert!(d.len() == 2 && d[0] == 0.0 && d[1] > 1.0, "{csv}");
     let md = std::fs::read_to_string(dir.path().join("against-first/sweep.md")).unwrap();
     let against = md
         .lines()
