@@ -17,19 +17,18 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::SymbolicSparseColMatRef;
 use faer::{Conj, MatMut, Par, Side};
 use std::ops::Range;
 
 /// Relative residual ‖b − Bx‖₂/‖b‖₂ at which a distributed CG solve stops: round-off, so that
 /// a distributed run agrees with a serial direct solve to about 1e-12 relative. Where
 /// round-off keeps the residual above it, the solve stops once the residual has not fallen
-/// for 8 iterations.
+/// for [`DISTRIBUTED_CG_STALL`] iterations.
 pub const DISTRIBUTED_CG_TOLERANCE: f64 = 1e-15;
 
 /// Iterations without a smaller residual after which a distributed CG solve has reached
 /// round-off and stops.
-const STALL: u64 = 8;
+pub const DISTRIBUTED_CG_STALL: u64 = 8;
 
 /// Iterations after which a distributed CG solve that has not reached its tolerance is
 /// refused ([`LinearError::CgDiverged`]).
@@ -82,10 +81,8 @@ impl<'a> Implicit<'a> {
         }
         let ghosts = ghosts_of(&self.sys, &own);
         let block = block_of(&self.sys, &own);
-        let n = block.len();
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &block.offsets, None, &block.cols);
         let symbolic = factorize_symbolic_cholesky(
-            pattern,
+            block.pattern(),
             Side::Lower,
             SymmetricOrdering::Amd,
             Default::default(),
@@ -187,7 +184,7 @@ impl<'a> Implicit<'a> {
             if rr < best {
                 (best, best_at) = (rr, its);
             }
-            if rr <= tol || its - best_at >= STALL {
+            if rr <= tol || its - best_at >= DISTRIBUTED_CG_STALL {
                 return Ok(its);
             }
             if its >= MAX_ITERATIONS || !rr.is_finite() {

@@ -14,7 +14,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, SymbolicLu};
 use faer::sparse::linalg::lu::{LuRef, NumericLu};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::SparseColMatRef;
 use faer::Par;
 use faer::{Conj, MatMut, Side};
 use std::time::Instant;
@@ -116,7 +116,7 @@ pub(super) fn symbolic(
     par: Par,
 ) -> Result<Symbolic> {
     let n = sys.len();
-    let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
+    let symbolic = sys.pattern();
     Ok(match options.solver {
         Solver::Cg => (None, None, MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
         Solver::Direct | Solver::Auto if sys.symmetric => {
@@ -266,14 +266,12 @@ pub(super) fn llt_values(
     c: f64,
     par: Par,
 ) -> Result<Vec<f64>> {
-    let n = sys.len();
-    let pattern = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
     let mut values = vec![0.0; s.len_val()];
     let req = s.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::new(req);
     s.factorize_numeric_llt(
         &mut values,
-        SparseColMatRef::new(pattern, vals),
+        SparseColMatRef::new(sys.pattern(), vals),
         Side::Lower,
         LltRegularization::default(),
         par,
@@ -313,14 +311,12 @@ impl Implicit<'_> {
         let factor = if let Some(s) = &self.chol {
             Factor::Llt(llt_values(s, sys, &self.b_vals, c, self.par)?)
         } else if let Some(s) = &self.lu {
-            let n = sys.len();
-            let pattern = SymbolicSparseColMatRef::new_checked(n, n, &sys.offsets, None, &sys.cols);
             let mut numeric = NumericLu::<usize, f64>::new();
             let req = s.factorize_numeric_lu_scratch::<f64>(self.par, Default::default());
             let mut mem = MemBuffer::new(req);
             s.factorize_numeric_lu(
                 &mut numeric,
-                SparseColMatRef::new(pattern, &self.b_vals),
+                SparseColMatRef::new(sys.pattern(), &self.b_vals),
                 self.par,
                 MemStack::new(&mut mem),
                 Default::default(),
@@ -467,6 +463,7 @@ impl Implicit<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::sparse::SymbolicSparseColMatRef;
 
     /// A dense SPD pattern of n unknowns factorises in n³/6 + O(n²) multiply-adds, whichever
     /// structure (supernodal or simplicial) faer chooses.

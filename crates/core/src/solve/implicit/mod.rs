@@ -53,7 +53,7 @@ mod steady;
 mod system;
 
 pub use adaptive::Adaptive;
-pub use distributed::{symmetric_over, DISTRIBUTED_CG_TOLERANCE};
+pub use distributed::{symmetric_over, DISTRIBUTED_CG_STALL, DISTRIBUTED_CG_TOLERANCE};
 pub use linear::{LinearError, Options, Solver};
 pub use ordering::{nested_dissection, Ordering};
 pub use schemes::Scheme;

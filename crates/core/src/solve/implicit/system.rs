@@ -266,6 +266,13 @@ impl System {
             .fold(0.0, f64::max)
     }
 
+    /// The sparsity pattern of A (CSR; A is stored symmetric in pattern, so it is the CSC
+    /// pattern too), as faer reads it.
+    pub(super) fn pattern(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+        let n = self.len();
+        faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &self.offsets, None, &self.cols)
+    }
+
     /// Number of unknowns (free body nodes).
     pub fn len(&self) -> usize {
         self.free.len()
