@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// `git rev-parse --short=12 HEAD` of the current directory, with `+changes` when tracked
-/// files differ from it; `unknown` outside a git work tree.
+/// files outside `validation/` differ from it (the figure files themselves are what a
+/// measurement rewrites); `unknown` outside a git work tree.
 pub fn commit() -> String {
     let git = |args: &[&str]| {
         let out = Command::new("git").args(args).output().ok()?;
@@ -19,7 +20,14 @@ pub fn commit() -> String {
             .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
     };
     match git(&["rev-parse", "--short=12", "HEAD"]) {
-        Some(head) => match git(&["status", "--porcelain", "--untracked-files=no"]) {
+        Some(head) => match git(&[
+            "status",
+            "--porcelain",
+            "--untracked-files=no",
+            "--",
+            ":/",
+            ":(top,exclude)validation",
+        ]) {
             Some(changes) if changes.is_empty() => head,
             _ => format!("{head}+changes"),
         },

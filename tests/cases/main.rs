@@ -10,6 +10,7 @@
 mod common {
     pub mod case;
     pub mod fd;
+    pub mod figures;
     pub mod runs;
 }
 

@@ -4,12 +4,34 @@
 //! solution.
 
 use crate::common::case::CaseToml;
+use crate::common::figures::Table;
 use peritherm::analytic::{neumann_front, Reference};
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::enthalpy::Enthalpic;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use std::path::Path;
+
+/// The phase-change checks (docs/validation.md).
+const PHASE: Table = Table {
+    name: "phase_checks",
+    command: "PERITHERM_RECORD=1 cargo test --release --test cases phase::",
+    columns: &["check", "measured", "criterion"],
+    keys: &[
+        "enthalpy stepper vs linear stepper, a material that never changes phase (1D mirror/flux/source; 2D axisymmetric flux/convection)",
+        "energy Σ V H, ice in water, insulated (free faces), axisymmetric 2D and spherical 1D",
+        "planar freezing (Δ = 5 mm, −10 °C face, +5 °C water, 48 h) against Neumann's front",
+        "`cases/pipe_freezing.toml` (the axisymmetric phase-change paper §3.3) against a radial finite-volume enthalpy solve (2 mm cells) at 1, 2, 3 days",
+    ],
+};
+
+/// Relative tolerance of a physical figure of these checks on another machine: explicit steppers
+/// give the same bits at any thread count, so only a printed digit may move.
+const PHYSICAL: f64 = 1e-6;
+/// Relative tolerance of a round-off figure (a difference or drift of 1e-14): it measures the
+/// summation order, which another compiler or instruction set may change; its criterion is the
+/// bound that matters.
+const ROUND_OFF: f64 = 10.0;
 
 /// With `phase` a phase change that never happens (T_f far above every temperature, frozen
 /// properties equal to the melted ones), which switches the model to the enthalpy stepper
@@ -62,6 +84,7 @@ fn case(which: usize, phase: bool) -> Case {
 /// instead of once, H = ρcθ instead of θ).
 #[test]
 fn enthalpy_form_equals_the_linear_form_without_phase_change() {
+    let mut measured = Vec::new();
     for which in 0..2 {
         let linear = Model::build(&case(which, false).spec).unwrap();
         let enth = Model::build(&case(which, true).spec).unwrap();
@@ -86,7 +109,14 @@ fn enthalpy_form_equals_the_linear_form_without_phase_change() {
         println!("geometry {which}: max |Δθ| = {diff:.3e} of {range:.3e}");
         assert!(range > 1.0);
         assert!(diff <= 1e-12 * range, "geometry {which}: {diff:e}");
+        measured.push(format!("{diff:.0e} of {range:.0} °C"));
     }
+    let cells = [
+        PHASE.keys[0],
+        &format!("max difference {}", measured.join(", ")),
+        "1e-12 relative",
+    ];
+    PHASE.row(cells.map(String::from).to_vec(), ROUND_OFF);
 }
 
 /// Total enthalpy Σ V_i H_i (ring or shell volumes) is conserved by phase change in an
@@ -119,6 +149,7 @@ fn energy_is_conserved_with_phase_change_in_symmetric_bodies() {
             .region_key("min = [0.03]")
             .region_key("initial = 60.0"),
     ];
+    let mut drifts = Vec::new();
     for body in bodies {
         let case = body
             .material("water", 0.6, 1000.0, 4182.0)
@@ -152,7 +183,18 @@ fn energy_is_conserved_with_phase_change_in_symmetric_bodies() {
         );
         assert!(partly > 0, "the test must cross the phase change");
         assert!(drift < 1e-12, "{drift:e}");
+        drifts.push(if drift == 0.0 {
+            "0".into()
+        } else {
+            format!("{drift:.0e}")
+        });
     }
+    let cells = [
+        PHASE.keys[1],
+        &format!("drift {}", drifts.join(", ")),
+        "1e-12 relative",
+    ];
+    PHASE.row(cells.map(String::from).to_vec(), ROUND_OFF);
 }
 
 /// Planar freezing: water at +5 °C, the face x = 0 held at −10 °C by a mirrored layer. The front
@@ -227,6 +269,12 @@ fn planar_freezing_follows_the_neumann_front() {
     let last = neumann_front(&neumann, t).unwrap();
     assert!(last > 20.0 * spacing, "the front must travel many spacings");
     assert!(worst <= 2.0 * spacing, "{worst}");
+    let measured = format!(
+        "largest front error {:.1} mm = {:.2} Δ",
+        1e3 * worst,
+        worst / spacing
+    );
+    PHASE.row(vec![PHASE.keys[2].into(), measured, "2Δ".into()], PHYSICAL);
 }
 
 /// Water's T(H) and λ(H) of the axisymmetric phase-change paper, eqs 1–3, written out again for the
@@ -301,6 +349,7 @@ fn pipe_freezing_matches_a_radial_finite_volume_reference() {
     let mut theta = model.theta0.clone();
     let mut st = Enthalpic::new(&model, Integrator::Euler).unwrap();
     let mut k = 0;
+    let (mut eps_all, mut fronts_pd, mut fronts_fv) = (Vec::new(), Vec::new(), Vec::new());
     let front = |xs: &[f64], th: &[f64]| -> f64 {
         let i = th.iter().position(|&v| v > 273.15).expect("water remains");
         xs[i - 1] + (273.15 - th[i - 1]) / (th[i] - th[i - 1]) * (xs[i] - xs[i - 1])
@@ -340,9 +389,23 @@ fn pipe_freezing_matches_a_radial_finite_volume_reference() {
             );
             assert!(eps <= 0.005, "ε = {eps}");
             assert!((f_pd - f_fv).abs() <= 2.0 * 0.01, "front {f_pd} vs {f_fv}");
+            eps_all.push(format!("{:.2} %", 100.0 * eps));
+            fronts_pd.push(format!("{f_pd:.3}"));
+            fronts_fv.push(format!("{f_fv:.3}"));
             Ok(())
         },
         |_| {},
     )
     .unwrap();
+    let measured = format!(
+        "ε (the paper's eq. 27) {}; ice front {} m against {} m",
+        eps_all.join(", "),
+        fronts_pd.join(" / "),
+        fronts_fv.join(" / ")
+    );
+    let criterion = "ε ≤ 0.5 %, front within 2Δ";
+    PHASE.row(
+        vec![PHASE.keys[3].into(), measured, criterion.into()],
+        PHYSICAL,
+    );
 }

@@ -2,12 +2,13 @@
 //! space against the analytical square and bar, the Bobaru & Duangpanya 2012 crack plate against an
 //! independent finite-difference solution, energy conservation, and the errors it gives.
 //!
-//! `cargo test --release --test convergence fem:: -- --nocapture` prints the measured figures
-//! quoted in the README.
+//! The measured figures are kept in validation/fem_checks.json and fem_steady_crack.json
+//! (`PERITHERM_RECORD=1` writes them, see tests/common/figures.rs); `-- --nocapture` prints them.
 
 use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
+use crate::common::figures::Table;
 use peritherm::case::Case;
 use peritherm::fem::run;
 use peritherm::fem::shape::shape;
@@ -15,6 +16,54 @@ use peritherm::fem::solve::{Scheme, Stepper};
 use peritherm::fem::FemModel;
 use peritherm::mesh::ElementKind;
 use std::path::PathBuf;
+
+/// The FEM reference's checks (docs/validation.md).
+const FEM_CHECKS: Table = Table {
+    name: "fem_checks",
+    command: "PERITHERM_RECORD=1 cargo test --release --test convergence fem::",
+    columns: &["check", "result", "criterion"],
+    keys: &[
+        "square, Bobaru & Duangpanya 2012 Ex. 1, t = 0.05 s, CN Δt = 1e-4 s, h = 1/8, 1/16, 1/32",
+        "bar, Bobaru & Duangpanya 2010 Ex. 1, t = 4 s, CN Δt = 1e-3 s, h = L/10 … L/80",
+        "bar with a held end at 5t·e^(−2t), Wang, Oterkus & Oterkus §4.2 in 1D, t = 3 s, CN Δt = 1e-3 s, h = L/20, L/40, L/80",
+        "crack plate, Bobaru & Duangpanya 2012 Ex. 3, FEM 200² quads vs FD 480² cells, at 0.5 s (both BE, 200 steps, from θ0 = 0)",
+        "the same, steady",
+        "insulated bodies (axisymmetric 2D, spherical 1D, 1D two materials, 2D with a crack, 3D hexes, gmsh triangles with their crack), 20 BE steps",
+    ],
+};
+
+/// The steady crack plate's resolution study (docs/validation.md).
+const FEM_STEADY_CRACK: Table = Table {
+    name: "fem_steady_crack",
+    command: "PERITHERM_RECORD=1 cargo test --release --test convergence fem::crack_plate_resolution_study -- --ignored",
+    columns: &[
+        "steady crack plate vs FD 960²",
+        "max abs diff (°C)",
+        "beyond 1 mm of the tips (°C)",
+    ],
+    keys: &["FD 240²", "FD 480²", "FEM 240²", "FEM 480²", "FEM 960²"],
+};
+
+/// Relative tolerance of these figures on another machine: the sparse Cholesky factorisations
+/// (faer) split their work by the thread count, which moves the fields by round-off only.
+const FEM_REL_TOL: f64 = 1e-6;
+
+/// Records the row `key` of [`FEM_CHECKS`] for errors at halved mesh sizes and their rates.
+fn record_rates(key: usize, errors: &[f64], rates: &[f64]) {
+    let errs: Vec<String> = errors.iter().map(|e| format!("{e:.3e}")).collect();
+    let rs: Vec<String> = rates.iter().map(|r| format!("{r:.2}")).collect();
+    let result = format!(
+        "max nodal error {} °C: rates **{}**",
+        errs.join(", "),
+        rs.join(", ")
+    );
+    let cells = vec![
+        FEM_CHECKS.keys[key].into(),
+        result,
+        "every rate ≥ 1.8".into(),
+    ];
+    FEM_CHECKS.row(cells, FEM_REL_TOL);
+}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -142,6 +191,7 @@ fn square_converges_at_second_order() {
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
     );
+    record_rates(0, &errors, &r);
 }
 
 /// Bobaru & Duangpanya 2010 Example 1 (bar L = 10 cm, α = 1.14 cm²/s, θ0 = 100 °C, ends held at 0
@@ -175,6 +225,7 @@ fn bar_converges_at_second_order() {
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
     );
+    record_rates(1, &errors, &r);
 }
 
 /// The Bobaru & Duangpanya 2012 Example 3 plate by the finite differences of tests/common/fd.rs (n
@@ -277,6 +328,19 @@ fn crack_plate_matches_finite_differences() {
     );
     assert!(t[2] < 0.5, "transient at 0.5 s: {t:?} °C");
     assert!(s[2] < 0.5, "steady: {s:?} °C");
+    for (key, d) in [(3, t), (4, s)] {
+        let result = format!(
+            "max abs diff **{:.2} °C** beyond 2δ = 2.17 mm of the tips, {:.2} °C beyond 1 mm, \
+             **{:.1} °C** at the tips",
+            d[2], d[1], d[0]
+        );
+        let cells = vec![
+            FEM_CHECKS.keys[key].into(),
+            result,
+            "0.5 °C beyond 2δ".into(),
+        ];
+        FEM_CHECKS.row(cells, FEM_REL_TOL);
+    }
 }
 
 /// An insulated body without sources keeps ∫ρcθ dV = Σ_i (Σ_j M_ij) θ_i to round-off
@@ -326,6 +390,7 @@ fn insulated_bodies_conserve_energy() {
             .initial("100*(y > 0)")
             .end(0.1),
     ];
+    let mut worst = 0.0f64;
     for case in &cases {
         let c = case.case(in_cases());
         let model = run::model(&c, None).unwrap();
@@ -349,7 +414,15 @@ fn insulated_bodies_conserve_energy() {
             "the field must evolve for the test to mean anything"
         );
         assert!((e - e0).abs() <= 1e-12 * e0.abs(), "{e0} -> {e}");
+        worst = worst.max((e - e0).abs() / e0.abs());
     }
+    // a round-off figure: another compiler or instruction set may change it several-fold; the
+    // 1e-12 bound above is what matters
+    let result = format!("∫ρcθ dV constant to ≤ {worst:.0e} relative");
+    FEM_CHECKS.row(
+        vec![FEM_CHECKS.keys[5].into(), result, "1e-12 relative".into()],
+        10.0,
+    );
 }
 
 /// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header (the
@@ -592,6 +665,8 @@ fn crack_plate_resolution_study() {
             }
         }
         lines.push(format!("| {name} | {tipd:.3} | {far:.3} |"));
+        let cells = vec![name, format!("{tipd:.3}"), format!("{far:.3}")];
+        FEM_STEADY_CRACK.row(cells, FEM_REL_TOL);
     };
     for (n, f) in &fd[..2] {
         study(format!("FD {n}²"), &|i, j, _, _| fd_at(*n, f, i, j));
@@ -743,6 +818,7 @@ fn time_dependent_held_end_converges_at_second_order() {
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
     );
+    record_rates(2, &errors, &r);
 }
 
 /// Max nodal error of the steady FEM solution of `text` on elements of size `h` against

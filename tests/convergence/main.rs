@@ -13,6 +13,7 @@ mod common {
     pub mod case;
     pub mod cli;
     pub mod fd;
+    pub mod figures;
     pub mod heat_fd;
 }
 
