@@ -625,7 +625,7 @@ const FIRST_HOPS: usize = 3;
 /// 5.57e-4 °C). Above it the local solve is kept for its cost: on the thermal-shock plate with
 /// the horizon doubled (2.2·10⁷ pairs) the whole solve took 253 s and 10.7 GB against 19 s and
 /// 1.9 GB.
-const WHOLE_PAIRS: usize = 1_000_000;
+pub const WHOLE_PAIRS: usize = 1_000_000;
 
 /// Corrects `k` in place so that the body nodes with `sel[i]` meet the moments of `order`
 /// (see the module documentation); `conductivity[i]` is the k_i of node i's target, W/(m·K).
