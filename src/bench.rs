@@ -14,6 +14,7 @@ use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::run::run_model;
 use crate::solve::explicit::Explicit;
+use crate::solve::implicit::ImplicitStats;
 use crate::solve::Integrator;
 use rayon::ThreadPool;
 use std::path::{Path, PathBuf};
@@ -36,13 +37,15 @@ pub struct BenchOptions {
     pub cases: Option<PathBuf>,
 }
 
-/// The explicit/implicit pairs of the comparison in docs/performance.md ("Time to solution,
-/// explicit against implicit").
-pub const CASES: [&str; 4] = [
+/// The explicit, fixed-step implicit and adaptive runs of the comparison in
+/// docs/performance.md ("Time to solution, explicit against implicit").
+pub const CASES: [&str; 6] = [
     "cases/dh_crack_plate_k1_m1.toml",
     "cases/dh_crack_plate_k1_m1_implicit.toml",
+    "cases/dh_crack_plate_k1_m1_adaptive.toml",
     "cases/thermal_shock_k1_m1.toml",
     "cases/thermal_shock_k1_m1_implicit.toml",
+    "cases/thermal_shock_k1_m1_adaptive.toml",
 ];
 
 /// Time to solution of one case run by `peritherm bench --cases`.
@@ -64,6 +67,8 @@ pub struct CaseRow {
     pub errors: Vec<(f64, f64)>,
     /// For Euler runs that used stencils: their bytes over the CSR's 12 B per entry of K; else None.
     pub stencils: Option<f64>,
+    /// Implicit runs: the solver's counts (tolerance, rejected steps, solves, factorisations).
+    pub implicit: Option<ImplicitStats>,
 }
 
 /// One row of the step table.
@@ -162,6 +167,7 @@ pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>>
                 .map(|r| (r.time, r.max_abs_diff))
                 .collect(),
             stencils,
+            implicit: s.implicit.clone(),
         });
     }
     Ok(rows)
@@ -616,7 +622,7 @@ impl BenchReport {
 
     /// The table of the timed cases (`--cases`).
     fn cases_table(&self) -> String {
-        let mut s = String::from("\n| case | integrator | K as | Δt (s) | steps | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|\n");
+        let mut s = String::from("\n| case | integrator | K as | Δt (s) | steps (rejected) | solves (by CG) | factorisations | set-up (s) | integration (s) | total (s) | max abs PD − reference (°C) at each output |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         for r in &self.cases {
             let errors: Vec<String> = r
                 .errors
@@ -626,14 +632,36 @@ impl BenchReport {
             let kas = match (r.integrator.as_str(), r.stencils) {
                 ("euler", Some(f)) => format!("stencils ({:.1} % of the CSR bytes)", 100.0 * f),
                 ("euler", None) => "CSR".to_string(),
+                _ if r.implicit.as_ref().is_some_and(|i| i.tolerance > 0.0) => {
+                    "factorised or CG".to_string()
+                }
                 _ => "factorised".to_string(),
             };
+            let (dt, rejected, solves, factorisations) = match &r.implicit {
+                Some(i) if i.tolerance > 0.0 => (
+                    format!("adaptive, tol {:e} K", i.tolerance),
+                    format!(" ({})", i.rejected),
+                    format!("{} ({})", i.solves, i.cg_solves),
+                    i.factorisations.to_string(),
+                ),
+                Some(i) => (
+                    format!("{:.3e}", r.dt),
+                    String::new(),
+                    format!("{} ({})", i.solves, i.cg_solves),
+                    i.factorisations.to_string(),
+                ),
+                None => (
+                    format!("{:.3e}", r.dt),
+                    String::new(),
+                    "-".into(),
+                    "-".into(),
+                ),
+            };
             s += &format!(
-                "| `{}` | {} | {} | {:.3e} | {} | {:.2} | {:.2} | {:.2} | {} |\n",
+                "| `{}` | {} | {} | {dt} | {}{rejected} | {solves} | {factorisations} | {:.2} | {:.2} | {:.2} | {} |\n",
                 r.case,
                 r.integrator,
                 kas,
-                r.dt,
                 r.steps,
                 r.setup,
                 r.integration,
