@@ -167,7 +167,7 @@ pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>>
                 .map(|r| (r.time, r.max_abs_diff))
                 .collect(),
             stencils,
-            implicit: s.implicit.clone(),
+            implicit: s.implicit,
         });
     }
     Ok(rows)
