@@ -776,3 +776,24 @@ fn summarise(p: &Problem, vals: &[Real], left_out: &[bool], out: &mut Consistenc
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Far from the solution a tenth of the residual (at most 1e-2); near it just enough for one
+    /// step to bring the residual to a tenth of [`TOLERANCE`].
+    #[test]
+    fn forcing_is_as_tight_as_the_step_needs() {
+        assert_eq!(forcing(1.0), 1e-2);
+        assert!((forcing(1e-3) - 1e-4).abs() <= 1e-4 * 1e-12);
+        for worst in [1e-6, 3.5e-9] {
+            let next = forcing(worst) * worst;
+            assert!(
+                (next - 0.1 * TOLERANCE).abs() <= 1e-12 * TOLERANCE,
+                "{worst}: {next}"
+            );
+        }
+        assert_eq!(forcing(0.5 * TOLERANCE), 1e-2);
+    }
+}
