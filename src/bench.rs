@@ -629,33 +629,27 @@ impl BenchReport {
                 .iter()
                 .map(|(t, e)| format!("{e:.3e} at {t} s"))
                 .collect();
+            // an adaptive run states its tolerance, a fixed-step one its Δt
+            let adaptive = r.implicit.filter(|i| i.tolerance > 0.0);
             let kas = match (r.integrator.as_str(), r.stencils) {
                 ("euler", Some(f)) => format!("stencils ({:.1} % of the CSR bytes)", 100.0 * f),
                 ("euler", None) => "CSR".to_string(),
-                _ if r.implicit.as_ref().is_some_and(|i| i.tolerance > 0.0) => {
-                    "factorised or CG".to_string()
-                }
+                _ if adaptive.is_some() => "factorised or CG".to_string(),
                 _ => "factorised".to_string(),
             };
-            let (dt, rejected, solves, factorisations) = match &r.implicit {
-                Some(i) if i.tolerance > 0.0 => (
+            let (dt, rejected) = match adaptive {
+                Some(i) => (
                     format!("adaptive, tol {:e} K", i.tolerance),
                     format!(" ({})", i.rejected),
-                    format!("{} ({})", i.solves, i.cg_solves),
-                    i.factorisations.to_string(),
                 ),
+                None => (format!("{:.3e}", r.dt), String::new()),
+            };
+            let (solves, factorisations) = match r.implicit {
                 Some(i) => (
-                    format!("{:.3e}", r.dt),
-                    String::new(),
                     format!("{} ({})", i.solves, i.cg_solves),
                     i.factorisations.to_string(),
                 ),
-                None => (
-                    format!("{:.3e}", r.dt),
-                    String::new(),
-                    "-".into(),
-                    "-".into(),
-                ),
+                None => ("-".into(), "-".into()),
             };
             s += &format!(
                 "| `{}` | {} | {} | {dt} | {}{rejected} | {solves} | {factorisations} | {:.2} | {:.2} | {:.2} | {} |\n",

@@ -139,7 +139,7 @@ fn temporal_orders_against_rk4() {
         measured.push(format!("{name} {}", o.join(", ")));
     }
     let cells = [IMPLICIT.keys[0], &measured.join("; "), "≥ 0.9, 1.8, 1.8"];
-    IMPLICIT.row(cells.map(String::from).to_vec(), IMPLICIT_REL_TOL);
+    IMPLICIT.row(&cells, IMPLICIT_REL_TOL);
 }
 
 /// Nodal Dirichlet (driven nodes) and Bobaru & Duangpanya 2010's flux relation (slaved nodes) are
@@ -502,7 +502,7 @@ fn adaptive_error_follows_the_tolerance() {
             .collect();
         let criterion = "≤ 20, falling with tol";
         let cells = [IMPLICIT.keys[key], &ratios.join(" / "), criterion];
-        IMPLICIT.row(cells.map(String::from).to_vec(), IMPLICIT_REL_TOL);
+        IMPLICIT.row(&cells, IMPLICIT_REL_TOL);
     }
 }
 
@@ -575,10 +575,7 @@ fn adaptive_steps_pay_after_a_boundary_jump() {
         s.solves, s.cg_solves
     );
     let criterion = "error ≤ 2 tol, at most a fifth of the fixed step's solves";
-    IMPLICIT.row(
-        vec![IMPLICIT.keys[3].into(), measured, criterion.into()],
-        IMPLICIT_REL_TOL,
-    );
+    IMPLICIT.row(&[IMPLICIT.keys[3], &measured, criterion], IMPLICIT_REL_TOL);
 }
 
 /// An insulated plate (mirrored layers, symmetric A) with a constant source s = 7 W/m³:

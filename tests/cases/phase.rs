@@ -116,7 +116,7 @@ fn enthalpy_form_equals_the_linear_form_without_phase_change() {
         &format!("max difference {}", measured.join(", ")),
         "1e-12 relative",
     ];
-    PHASE.row(cells.map(String::from).to_vec(), ROUND_OFF);
+    PHASE.row(&cells, ROUND_OFF);
 }
 
 /// Total enthalpy Σ V_i H_i (ring or shell volumes) is conserved by phase change in an
@@ -194,7 +194,7 @@ fn energy_is_conserved_with_phase_change_in_symmetric_bodies() {
         &format!("drift {}", drifts.join(", ")),
         "1e-12 relative",
     ];
-    PHASE.row(cells.map(String::from).to_vec(), ROUND_OFF);
+    PHASE.row(&cells, ROUND_OFF);
 }
 
 /// Planar freezing: water at +5 °C, the face x = 0 held at −10 °C by a mirrored layer. The front
@@ -274,7 +274,7 @@ fn planar_freezing_follows_the_neumann_front() {
         1e3 * worst,
         worst / spacing
     );
-    PHASE.row(vec![PHASE.keys[2].into(), measured, "2Δ".into()], PHYSICAL);
+    PHASE.row(&[PHASE.keys[2], &measured, "2Δ"], PHYSICAL);
 }
 
 /// Water's T(H) and λ(H) of the axisymmetric phase-change paper, eqs 1–3, written out again for the
@@ -404,8 +404,5 @@ fn pipe_freezing_matches_a_radial_finite_volume_reference() {
         fronts_fv.join(" / ")
     );
     let criterion = "ε ≤ 0.5 %, front within 2Δ";
-    PHASE.row(
-        vec![PHASE.keys[3].into(), measured, criterion.into()],
-        PHYSICAL,
-    );
+    PHASE.row(&[PHASE.keys[3], &measured, criterion], PHYSICAL);
 }

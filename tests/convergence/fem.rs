@@ -50,19 +50,14 @@ const FEM_REL_TOL: f64 = 1e-6;
 
 /// Records the row `key` of [`FEM_CHECKS`] for errors at halved mesh sizes and their rates.
 fn record_rates(key: usize, errors: &[f64], rates: &[f64]) {
-    let errs: Vec<String> = errors.iter().map(|e| format!("{e:.3e}")).collect();
     let rs: Vec<String> = rates.iter().map(|r| format!("{r:.2}")).collect();
     let result = format!(
         "max nodal error {} °C: rates **{}**",
-        errs.join(", "),
+        sci(errors),
         rs.join(", ")
     );
-    let cells = vec![
-        FEM_CHECKS.keys[key].into(),
-        result,
-        "every rate ≥ 1.8".into(),
-    ];
-    FEM_CHECKS.row(cells, FEM_REL_TOL);
+    let cells = [FEM_CHECKS.keys[key], &result, "every rate ≥ 1.8"];
+    FEM_CHECKS.row(&cells, FEM_REL_TOL);
 }
 
 fn root() -> PathBuf {
@@ -334,12 +329,10 @@ fn crack_plate_matches_finite_differences() {
              **{:.1} °C** at the tips",
             d[2], d[1], d[0]
         );
-        let cells = vec![
-            FEM_CHECKS.keys[key].into(),
-            result,
-            "0.5 °C beyond 2δ".into(),
-        ];
-        FEM_CHECKS.row(cells, FEM_REL_TOL);
+        FEM_CHECKS.row(
+            &[FEM_CHECKS.keys[key], &result, "0.5 °C beyond 2δ"],
+            FEM_REL_TOL,
+        );
     }
 }
 
@@ -419,10 +412,7 @@ fn insulated_bodies_conserve_energy() {
     // a round-off figure: another compiler or instruction set may change it several-fold; the
     // 1e-12 bound above is what matters
     let result = format!("∫ρcθ dV constant to ≤ {worst:.0e} relative");
-    FEM_CHECKS.row(
-        vec![FEM_CHECKS.keys[5].into(), result, "1e-12 relative".into()],
-        10.0,
-    );
+    FEM_CHECKS.row(&[FEM_CHECKS.keys[5], &result, "1e-12 relative"], 10.0);
 }
 
 /// `peritherm fem` writes the contract of `peritherm run`: field_<k>.csv with the same header (the
@@ -665,8 +655,8 @@ fn crack_plate_resolution_study() {
             }
         }
         lines.push(format!("| {name} | {tipd:.3} | {far:.3} |"));
-        let cells = vec![name, format!("{tipd:.3}"), format!("{far:.3}")];
-        FEM_STEADY_CRACK.row(cells, FEM_REL_TOL);
+        let (tipd, far) = (format!("{tipd:.3}"), format!("{far:.3}"));
+        FEM_STEADY_CRACK.row(&[&name, &tipd, &far], FEM_REL_TOL);
     };
     for (n, f) in &fd[..2] {
         study(format!("FD {n}²"), &|i, j, _, _| fd_at(*n, f, i, j));
