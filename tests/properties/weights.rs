@@ -233,6 +233,7 @@ fn committed_meshes(max_bytes: u64) -> Vec<PathBuf> {
 fn assert_none_refused(files: &[PathBuf]) {
     assert!(!files.is_empty());
     for f in files {
+        let start = std::time::Instant::now();
         let m = default_model(f).unwrap_or_else(|e| panic!("{}: refused: {e}", f.display()));
         let c = m.correction.expect("mesh cases are corrected by default");
         assert!(
@@ -241,14 +242,18 @@ fn assert_none_refused(files: &[PathBuf]) {
             f.display()
         );
         eprintln!(
-            "{}: {} nodes, {} corrected, {} left out (worst {:.2e}), K ratios {:.1e}..{:.1e}",
+            "{}: {} nodes, {} corrected, {} left out (worst {:.2e}), K ratios {:.1e}..{:.1e}, \
+             {} Newton / {} CG iterations, built in {:.0} s",
             f.file_name().unwrap().to_string_lossy(),
             m.cloud.n_body,
             c.corrected,
             c.uncorrected,
             c.worst_uncorrected,
             c.min_ratio,
-            c.max_ratio
+            c.max_ratio,
+            c.newton,
+            c.iterations,
+            start.elapsed().as_secs_f64()
         );
     }
 }
