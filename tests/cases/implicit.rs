@@ -21,6 +21,7 @@ const IMPLICIT: Table = Table {
         "adaptive BDF2: worst output error / tol at tol = 1e-3, 1e-4, 1e-5",
         "after a boundary jump: adaptive Crank–Nicolson at tol 1e-4 against the fixed step of the same accuracy",
     ],
+    timed: &[],
 };
 
 /// Relative tolerance of these figures on another machine: the factorisations split their work

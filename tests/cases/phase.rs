@@ -23,6 +23,7 @@ const PHASE: Table = Table {
         "planar freezing (Δ = 5 mm, −10 °C face, +5 °C water, 48 h) against Neumann's front",
         "`cases/pipe_freezing.toml` (the axisymmetric phase-change paper §3.3) against a radial finite-volume enthalpy solve (2 mm cells) at 1, 2, 3 days",
     ],
+    timed: &[],
 };
 
 /// Relative tolerance of a physical figure of these checks on another machine: explicit steppers

@@ -30,6 +30,7 @@ const FEM_CHECKS: Table = Table {
         "the same, steady",
         "insulated bodies (axisymmetric 2D, spherical 1D, 1D two materials, 2D with a crack, 3D hexes, gmsh triangles with their crack), 20 BE steps",
     ],
+    timed: &[],
 };
 
 /// The steady crack plate's resolution study (docs/validation.md).
@@ -42,6 +43,7 @@ const FEM_STEADY_CRACK: Table = Table {
         "beyond 1 mm of the tips (°C)",
     ],
     keys: &["FD 240²", "FD 480²", "FEM 240²", "FEM 480²", "FEM 960²"],
+    timed: &[],
 };
 
 /// Relative tolerance of these figures on another machine: the sparse Cholesky factorisations

@@ -10,6 +10,7 @@
 #[path = "../common"]
 mod common {
     pub mod case;
+    pub mod figures;
 }
 
 mod boundary;

@@ -4,6 +4,7 @@
 //! mixed, graded 4×, tetrahedra; the hexahedra of moments_hex.msh are the open case below).
 
 use crate::common::case::CaseToml;
+use crate::common::figures::Table;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
 use peritherm::weights::Order;
@@ -228,33 +229,111 @@ fn committed_meshes(max_bytes: u64) -> Vec<PathBuf> {
     files
 }
 
+/// The set-up of the consistent weights on every committed mesh (docs/performance.md).
+const EVERY_MESH: Table = Table {
+    name: "every_mesh",
+    command: "PERITHERM_RECORD=1 cargo test --release --test properties weights::no_committed_mesh_is_refused_large_ones_included -- --ignored",
+    columns: &[
+        "mesh",
+        "body nodes",
+        "corrected",
+        "left out (worst relative moment error)",
+        "K'/K from .. to",
+        "Newton / CG iterations",
+        "model built in (s)",
+        "peak resident (GB)",
+    ],
+    keys: &[
+        "annulus.msh",
+        "block_refined.msh",
+        "conv_cube_tet_L1.msh",
+        "conv_cube_tet_L2.msh",
+        "conv_cube_tet_L3.msh",
+        "conv_cube_tet_L4.msh",
+        "conv_disc_L1.msh",
+        "conv_disc_L2.msh",
+        "conv_disc_L3.msh",
+        "conv_disc_L4.msh",
+        "conv_graded_L1.msh",
+        "conv_graded_L2.msh",
+        "conv_graded_L3.msh",
+        "conv_graded_L4.msh",
+        "conv_rect_quad_L1.msh",
+        "conv_rect_quad_L2.msh",
+        "conv_rect_quad_L3.msh",
+        "conv_rect_quad_L4.msh",
+        "conv_rect_tri_L1.msh",
+        "conv_rect_tri_L2.msh",
+        "conv_rect_tri_L3.msh",
+        "conv_rect_tri_L4.msh",
+        "crack_plate_refined.msh",
+        "crack_plate_uniform.msh",
+        "dh_plate_k0.5.msh",
+        "dh_plate_k1.msh",
+        "l_shape.msh",
+        "moments_graded.msh",
+        "moments_hex.msh",
+        "moments_mixed.msh",
+        "moments_quad.msh",
+        "moments_tet.msh",
+        "moments_tri.msh",
+        "pipe_heating_d0.01.msh",
+        "pipe_heating_d0.02.msh",
+        "pipe_heating_d0.04.msh",
+        "pipe_heating_fem.msh",
+    ],
+    timed: &[6, 7],
+};
+
+/// Relative tolerance of the counts and ratios on another machine: the Newton iterations and
+/// parallel sums are the same bits at any thread count, but another CPU's `exp` may differ in
+/// its last bit and an iteration count may then move by one or two.
+const EVERY_MESH_REL_TOL: f64 = 0.05;
+
+/// Forgets the process's peak resident set so far (Linux; elsewhere a no-op).
+fn reset_peak_resident() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// The process's peak resident set since [`reset_peak_resident`], in GB (Linux), or "-".
+fn peak_resident_gb() -> String {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let kb = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok());
+    kb.map_or("-".into(), |kb| format!("{:.1}", kb * 1024.0 / 1e9))
+}
+
 /// Builds every mesh in `files` with the default settings; none may be refused, and every
-/// node the correction leaves out is counted (corrected + left out = body nodes).
+/// node the correction leaves out is counted (corrected + left out = body nodes). Each mesh's
+/// row of [`EVERY_MESH`] is recorded or checked.
 fn assert_none_refused(files: &[PathBuf]) {
     assert!(!files.is_empty());
     for f in files {
+        let name = f.file_name().unwrap().to_string_lossy().to_string();
+        reset_peak_resident();
         let start = std::time::Instant::now();
-        let m = default_model(f).unwrap_or_else(|e| panic!("{}: refused: {e}", f.display()));
+        let m = default_model(f).unwrap_or_else(|e| panic!("{name}: refused: {e}"));
+        let seconds = start.elapsed().as_secs_f64();
         let c = m.correction.expect("mesh cases are corrected by default");
         assert!(
             c.corrected + c.uncorrected <= m.cloud.n_body,
-            "{}: {c:?}",
-            f.display()
+            "{name}: {c:?}"
         );
-        eprintln!(
-            "{}: {} nodes, {} corrected, {} left out (worst {:.2e}), K ratios {:.1e}..{:.1e}, \
-             {} Newton / {} CG iterations, built in {:.0} s",
-            f.file_name().unwrap().to_string_lossy(),
-            m.cloud.n_body,
-            c.corrected,
-            c.uncorrected,
-            c.worst_uncorrected,
-            c.min_ratio,
-            c.max_ratio,
-            c.newton,
-            c.iterations,
-            start.elapsed().as_secs_f64()
-        );
+        let cells = [
+            name.clone(),
+            m.cloud.n_body.to_string(),
+            c.corrected.to_string(),
+            format!("{} ({:.1e})", c.uncorrected, c.worst_uncorrected),
+            format!("{:.1e} .. {:.1e}", c.min_ratio, c.max_ratio),
+            format!("{} / {}", c.newton, c.iterations),
+            format!("{seconds:.0}"),
+            peak_resident_gb(),
+        ];
+        eprintln!("{}", cells.join(" | "));
+        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
+        EVERY_MESH.row(&cells, EVERY_MESH_REL_TOL);
     }
 }
 
