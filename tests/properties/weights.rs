@@ -200,8 +200,8 @@ fn hexahedra_left_out_nodes_are_reported_not_refused() {
 
 /// Every body group of `file` (under meshes/) as a region with δ = 3Δ, one material, no
 /// boundary named (so every boundary takes the default, an insulating mirrored layer), the
-/// default kernel: the consistent weights are on.
-fn default_model(file: &Path) -> Result<Model, String> {
+/// default kernel: the consistent weights are on. Also the set-up's memory estimate, bytes.
+fn default_model(file: &Path) -> Result<(Model, f64), String> {
     let mesh = peritherm::gmsh::read(file).map_err(|e| e.to_string())?;
     let dim = mesh.dim();
     let body = mesh.groups.iter().filter(|g| g.dim == dim);
@@ -213,7 +213,8 @@ fn default_model(file: &Path) -> Result<Model, String> {
         .end(1.0);
     let case = peritherm::case::Case::parse(&toml.text(), Path::new("every_mesh.toml"))
         .map_err(|e| e.to_string())?;
-    Model::build(&case.spec).map_err(|e| e.to_string())
+    let model = Model::build(&case.spec).map_err(|e| e.to_string())?;
+    Ok((model, case.budget.bytes))
 }
 
 /// The committed meshes of meshes/ with at most `max_bytes` bytes (all: usize::MAX).
@@ -242,6 +243,7 @@ const EVERY_MESH: Table = Table {
         "Newton / CG iterations",
         "model built in (s)",
         "peak resident (GB)",
+        "estimated (GB)",
     ],
     keys: &[
         "annulus.msh",
@@ -314,7 +316,7 @@ fn assert_none_refused(files: &[PathBuf]) {
         let name = f.file_name().unwrap().to_string_lossy().to_string();
         reset_peak_resident();
         let start = std::time::Instant::now();
-        let m = default_model(f).unwrap_or_else(|e| panic!("{name}: refused: {e}"));
+        let (m, estimate) = default_model(f).unwrap_or_else(|e| panic!("{name}: refused: {e}"));
         let seconds = start.elapsed().as_secs_f64();
         let c = m.correction.expect("mesh cases are corrected by default");
         assert!(
@@ -330,6 +332,7 @@ fn assert_none_refused(files: &[PathBuf]) {
             format!("{} / {}", c.newton, c.iterations),
             format!("{seconds:.0}"),
             peak_resident_gb(),
+            format!("{:.1}", estimate / 1e9),
         ];
         eprintln!("{}", cells.join(" | "));
         let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
