@@ -13,11 +13,10 @@ them from the cloud (`Partition::by_estimate`), which `peritherm partition` repo
 Needs the Python package and METIS's binding: pip install ./python pymetis numpy
 Usage: python3 scripts/partitioners.py [CASE ...]
 """
-import datetime
-import json
 import os
-import subprocess
 import sys
+
+import figure_file
 
 import numpy as np
 import peritherm
@@ -67,23 +66,6 @@ def measure(rows, cols, work, part, ranks):
     return ghosts.max(), ghosts.sum(), neighbours.max(), load.max() / load.mean()
 
 
-def provenance():
-    commit = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True, text=True).stdout.strip()
-    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD"]).returncode != 0
-    machine = "unknown"
-    for line in open("/proc/cpuinfo"):
-        if line.startswith("model name"):
-            machine = line.split(":", 1)[1].strip()
-            break
-    return {
-        "commit": commit + ("+changes" if dirty else ""),
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d"),
-        "machine": machine,
-        "threads": os.cpu_count(),
-        "load": round(os.getloadavg()[0], 2),
-    }
-
-
 def main(cases):
     table = []
     for case in cases:
@@ -97,16 +79,8 @@ def main(cases):
                 g_max, g_all, nbr, imbalance = measure(rows, cols, work, part, ranks)
                 table.append([name, str(model.n_body), str(ranks), method, str(g_max), str(g_all), str(nbr), f"{imbalance:.3f}"])
                 print(" | ".join(table[-1]), flush=True)
-    figures = {
-        "name": "partitioners",
-        "command": "python3 scripts/partitioners.py",
-        "provenance": provenance(),
-        "columns": ["case", "body nodes", "ranks", "partition", "most ghosts", "ghosts in all", "most neighbour ranks", "most work / mean"],
-        "rows": table,
-        "checks": [],
-    }
-    with open("validation/partitioners.json", "w") as f:
-        f.write(json.dumps(figures, indent=2, ensure_ascii=False) + "\n")
+    columns = ["case", "body nodes", "ranks", "partition", "most ghosts", "ghosts in all", "most neighbour ranks", "most work / mean"]
+    figure_file.write("partitioners", "python3 scripts/partitioners.py", columns, table)
 
 
 if __name__ == "__main__":

@@ -130,6 +130,8 @@ pub struct BenchReport {
     pub cases: Vec<CaseRow>,
     /// Peak resident set of the process at the end, bytes (Linux VmHWM; None elsewhere).
     pub peak_rss: Option<u64>,
+    /// The plate's node count asked for with `--nodes` (None: the standard plates).
+    pub nodes: Option<usize>,
 }
 
 /// Runs [`CASES`] into `out/<case name>/` and times them.
@@ -419,6 +421,7 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         steps,
         setup,
         peak_rss: peak_rss(),
+        nodes: opts.nodes,
     })
 }
 
@@ -529,22 +532,45 @@ impl BenchReport {
     }
 
     /// The tables as figure files (`bench_bandwidth`, `bench_step`, `bench_setup` and, with
-    /// `--cases`, `bench_cases`), measured by `command`.
+    /// `--cases`, `bench_cases`), measured by `command`. With `--nodes N` the one plate's
+    /// `bench_step_<N>`, `bench_setup_<N>` and `bench_memory_<N>` (N as 1e7): the triad beside
+    /// a model of that size is disturbed, so no bandwidth table.
     pub fn figures(&self, command: &str) -> Vec<peritherm_post::figures::Figures> {
         use peritherm_post::figures::from_markdown;
-        let mut tables = vec![
-            ("bench_bandwidth", self.bandwidth_table()),
-            ("bench_step", self.step_table()),
-            ("bench_setup", self.setup_table()),
-        ];
+        let mut tables = match self.nodes {
+            None => vec![
+                ("bench_bandwidth", self.bandwidth_table()),
+                ("bench_step", self.step_table()),
+                ("bench_setup", self.setup_table()),
+            ],
+            Some(_) => vec![
+                ("bench_step", self.step_table()),
+                ("bench_setup", self.setup_table()),
+                ("bench_memory", self.memory_table()),
+            ],
+        };
         if !self.cases.is_empty() {
             tables.push(("bench_cases", self.cases_table()));
         }
+        let suffix = self.nodes.map_or(String::new(), |n| format!("_{n:.0e}"));
         let provenance = crate::figures::provenance(self.threads);
         let figure = |(name, table): (&str, String)| {
-            from_markdown(name, command, provenance.clone(), &table)
+            from_markdown(
+                &format!("{name}{suffix}"),
+                command,
+                provenance.clone(),
+                &table,
+            )
         };
         tables.into_iter().map(figure).collect()
+    }
+
+    /// The process's peak resident set as a table of one row.
+    fn memory_table(&self) -> String {
+        let peak = self
+            .peak_rss
+            .map_or("-".into(), |b| format!("{:.1}", b as f64 / 1e9));
+        format!("| process | peak resident set (GB) |\n|---|---|\n| `peritherm bench` | {peak} |\n")
     }
 
     /// The bond updates per second that a bandwidth of `gbs` GB/s allows at

@@ -320,22 +320,56 @@ type = "insulated"
     }
 }
 
-/// Per-solve cost of the direct solver against Jacobi-PCG on the two study cases at the Δt of
-/// their implicit variants (prints; run with `--ignored --nocapture`; minutes).
+/// The implicit solvers' costs per case (docs/performance.md, "Implicit solver choices").
+const SOLVERS: Table = Table {
+    name: "implicit_solvers",
+    command: "PERITHERM_RECORD=1 cargo test --release --test cases implicit::per_solve_direct_vs_cg -- --ignored",
+    columns: &[
+        "case and linear solver (Crank–Nicolson)",
+        "Δt",
+        "unknowns",
+        "nnz(L)",
+        "factorisation (s)",
+        "solves",
+        "per solve (s)",
+        "CG iterations",
+    ],
+    keys: &[
+        "dh_crack_plate_k1_m1_implicit, direct, nested dissection",
+        "dh_crack_plate_k1_m1_implicit, direct, AMD",
+        "dh_crack_plate_k1_m1_implicit, Jacobi CG",
+        "thermal_shock_k1_m1_implicit, direct, nested dissection",
+        "thermal_shock_k1_m1_implicit, direct, AMD",
+        "thermal_shock_k1_m1_implicit, Jacobi CG",
+    ],
+    timed: &[4, 6],
+};
+
+/// Relative tolerance of the solver counts (fill, iterations) on another machine: the
+/// orderings and CG are deterministic, but the factorisations split their work by the thread
+/// count, so an iteration count may move by one.
+const SOLVERS_REL_TOL: f64 = 0.05;
+
+/// Per-solve cost of the direct solver (two orderings) against Jacobi-PCG on the two study
+/// cases at the Δt of their implicit variants; records [`SOLVERS`] (minutes).
 #[test]
 #[ignore]
 fn per_solve_direct_vs_cg() {
     for (file, dt, steps) in [
-        ("cases/dh_crack_plate_k1_m1_implicit.toml", 0.01, 10),
-        ("cases/thermal_shock_k1_m1_implicit.toml", 0.05, 4),
+        ("dh_crack_plate_k1_m1_implicit", 0.01, 10),
+        ("thermal_shock_k1_m1_implicit", 0.05, 4),
     ] {
-        let case = Case::load(Path::new(file)).unwrap();
+        let case = Case::load(Path::new(&format!("cases/{file}.toml"))).unwrap();
         let dt = case.dt.unwrap_or(dt);
         let model = Model::build(&case.spec).unwrap();
-        for (solver, ordering) in [
-            (Solver::Direct, Ordering::NestedDissection),
-            (Solver::Direct, Ordering::Amd),
-            (Solver::Cg, Ordering::Amd),
+        for (solver, ordering, name) in [
+            (
+                Solver::Direct,
+                Ordering::NestedDissection,
+                "direct, nested dissection",
+            ),
+            (Solver::Direct, Ordering::Amd, "direct, AMD"),
+            (Solver::Cg, Ordering::Amd, "Jacobi CG"),
         ] {
             let o = Options {
                 solver,
@@ -343,53 +377,64 @@ fn per_solve_direct_vs_cg() {
                 ..Options::default()
             };
             let mut theta = model.theta0.clone();
-            let started = std::time::Instant::now();
             let mut st = Implicit::new(&model, Scheme::CrankNicolson, o).unwrap();
-            let built = started.elapsed().as_secs_f64();
-            st.run(
-                &mut theta,
-                0.0,
-                dt,
-                &[dt * steps as f64],
-                |_, _, _, _| Ok(()),
-                |_| {},
-            )
-            .unwrap();
+            let end = [dt * steps as f64];
+            st.run(&mut theta, 0.0, dt, &end, |_, _, _, _| Ok(()), |_| {})
+                .unwrap();
             let s = st.stats;
-            println!(
-                "{file} {solver:?} {ordering:?}: n = {}, symmetric = {} ({:.1e}), build {built:.2} s, nnz(L) {}, factor {:.2} s ({}), {} solves {:.4} s each, CG iterations {}",
-                st.system().len(),
-                st.system().symmetric,
-                st.system().asymmetry,
-                s.factor_entries,
-                s.factor_seconds,
-                s.factorisations,
-                s.solves,
-                s.solve_seconds / s.solves as f64,
-                s.cg_iterations
-            );
+            let cells = [
+                format!("{file}, {name}"),
+                format!("{dt} s"),
+                st.system().len().to_string(),
+                format!("{:.3e}", s.factor_entries as f64),
+                format!("{:.2}", s.factor_seconds),
+                s.solves.to_string(),
+                format!("{:.4}", s.solve_seconds / s.solves as f64),
+                s.cg_iterations.to_string(),
+            ];
+            let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
+            SOLVERS.row(&cells, SOLVERS_REL_TOL);
         }
     }
 }
 
-/// Prints the asymmetry of A for a few bundled cases (run with `--ignored --nocapture`).
+/// The asymmetry of the eliminated system matrix A (docs/validation.md).
+const ASYMMETRY: Table = Table {
+    name: "asymmetry",
+    command:
+        "PERITHERM_RECORD=1 cargo test --release --test cases implicit::asymmetry_of_a -- --ignored",
+    columns: &[
+        "case",
+        "max |A_ij − A_ji| / max A_ii",
+        "solved as symmetric",
+    ],
+    keys: &[
+        "annulus_steady",
+        "dh_plate_k0.5_m1",
+        "bar_flux",
+        "crack_plate_refined",
+        "dh_crack_plate_k2_m1",
+    ],
+    timed: &[],
+};
+
+/// Records [`ASYMMETRY`] for a few bundled cases: where the mirrors and relations of the
+/// boundary break the symmetry of A, and by how much (a minute).
 #[test]
 #[ignore]
-fn print_asymmetry() {
-    for file in [
-        "cases/annulus_steady.toml",
-        "cases/dh_plate_k0.5_m1.toml",
-        "cases/bar_flux.toml",
-        "cases/crack_plate_refined.toml",
-        "cases/dh_crack_plate_k2_m1.toml",
-    ] {
-        let case = Case::load(Path::new(file)).unwrap();
+fn asymmetry_of_a() {
+    for name in ASYMMETRY.keys {
+        let case = Case::load(Path::new(&format!("cases/{name}.toml"))).unwrap();
         let model = Model::build(&case.spec).unwrap();
         let sys = peritherm::solve::implicit::System::build(&model).unwrap();
-        println!(
-            "{file}: asymmetry {:.2e}, symmetric {}",
-            sys.asymmetry, sys.symmetric
-        );
+        let cells = [
+            name.to_string(),
+            format!("{:.1e}", sys.asymmetry),
+            if sys.symmetric { "yes" } else { "no" }.to_string(),
+        ];
+        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
+        // the asymmetry is a property of the model: the same bits on any machine up to `exp`
+        ASYMMETRY.row(&cells, 0.01);
     }
 }
 
@@ -730,29 +775,45 @@ fn adaptive_run_reports_its_counters() {
     assert_eq!(read.fields.len(), 2);
 }
 
-/// The automatic solver choice against the direct solver alone on the adaptive crack plate
-/// (prints wall time, solves and factorisations; run with `--ignored --nocapture`; ~1 min).
+/// The automatic solver choice of adaptive runs against the direct solver alone.
+const SOLVER_CHOICE: Table = Table {
+    name: "adaptive_solver_choice",
+    command: "PERITHERM_RECORD=1 cargo test --release --test cases implicit::adaptive_auto_vs_direct -- --ignored",
+    columns: &[
+        "adaptive Crank–Nicolson, dh_crack_plate_k1_m1, tol 1e-3",
+        "steps",
+        "solves (by CG, CG iterations)",
+        "factorisations",
+        "factorising (s)",
+        "whole run (s)",
+    ],
+    keys: &["solver = auto", "solver = direct"],
+    timed: &[4, 5],
+};
+
+/// The automatic solver choice against the direct solver alone on the adaptive crack plate;
+/// records [`SOLVER_CHOICE`] (about a minute).
 #[test]
 #[ignore]
 fn adaptive_auto_vs_direct() {
     let case = Case::load(Path::new("cases/dh_crack_plate_k1_m1_adaptive.toml")).unwrap();
     let model = Model::build(&case.spec).unwrap();
-    for solver in [Solver::Auto, Solver::Direct] {
+    for (solver, name) in [(Solver::Auto, "auto"), (Solver::Direct, "direct")] {
         let o = Options {
             solver,
             ..Options::default()
         };
         let started = std::time::Instant::now();
         let (_, s) = adaptive(&model, Scheme::CrankNicolson, 1e-3, &case.outputs, o);
-        println!(
-            "{solver:?}: {:.2} s, {} steps, {} solves ({} by CG, {} iterations), {} factorisations ({:.2} s)",
-            started.elapsed().as_secs_f64(),
-            s.accepted,
-            s.solves,
-            s.cg_solves,
-            s.cg_iterations,
-            s.factorisations,
-            s.factor_seconds
-        );
+        let cells = [
+            format!("solver = {name}"),
+            s.accepted.to_string(),
+            format!("{} ({}, {})", s.solves, s.cg_solves, s.cg_iterations),
+            s.factorisations.to_string(),
+            format!("{:.2}", s.factor_seconds),
+            format!("{:.2}", started.elapsed().as_secs_f64()),
+        ];
+        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
+        SOLVER_CHOICE.row(&cells, IMPLICIT_REL_TOL);
     }
 }
