@@ -386,8 +386,15 @@ fn per_solve_direct_vs_cg() {
                 format!("{file}, {name}"),
                 format!("{dt} s"),
                 st.system().len().to_string(),
-                format!("{:.3e}", s.factor_entries as f64),
-                format!("{:.2}", s.factor_seconds),
+                // CG factorises nothing
+                match solver {
+                    Solver::Cg => "-".into(),
+                    _ => format!("{:.3e}", s.factor_entries as f64),
+                },
+                match solver {
+                    Solver::Cg => "-".into(),
+                    _ => format!("{:.2}", s.factor_seconds),
+                },
                 s.solves.to_string(),
                 format!("{:.4}", s.solve_seconds / s.solves as f64),
                 s.cg_iterations.to_string(),
