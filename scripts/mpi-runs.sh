@@ -4,8 +4,9 @@
 # default build on 2 threads against the MPI build on 2 ranks of 1 thread (median of three
 # runs each), and the fixed-step Crank–Nicolson crack plate (one run each). Fails unless the
 # explicit fields are the same bytes and the implicit ones agree within 1e-12 of their largest
-# magnitude (scripts/fields-differ.py). Writes validation/mpi_explicit.json and
-# validation/mpi_implicit.json and the docs' tables; runs go to out/mpi-runs/. Needs MPI (see
+# magnitude (scripts/fields-differ.py). Also times planning 4096 ranks of the 10⁷-node plate
+# (`peritherm partition`). Writes validation/mpi_explicit.json, validation/mpi_implicit.json
+# and validation/partition_plan.json and the docs' tables; runs go to out/mpi-runs/. Needs MPI (see
 # docs/distributed.md); about 3 minutes on 2 cores plus the two builds.
 # Usage: bash scripts/mpi-runs.sh
 set -euo pipefail
@@ -35,4 +36,6 @@ python3 scripts/timed-commands.py mpi_implicit --by "bash scripts/mpi-runs.sh" \
   "$serial --threads 2 run $crack --out $out/crack/serial" \
   "$mpi run $crack --out $out/crack/ranks2"
 python3 scripts/fields-differ.py "$out/crack/serial" "$out/crack/ranks2" 1e-12
+python3 scripts/timed-commands.py partition_plan --by "bash scripts/mpi-runs.sh" -- \
+  "$serial partition cases/large/plate_1e7.toml --ranks 4096 > /dev/null"
 bash scripts/update-docs.sh
