@@ -36,6 +36,7 @@ python3 scripts/timed-commands.py mpi_implicit --by "bash scripts/mpi-runs.sh" \
   "$serial --threads 2 run $crack --out $out/crack/serial" \
   "$mpi run $crack --out $out/crack/ranks2"
 python3 scripts/fields-differ.py "$out/crack/serial" "$out/crack/ranks2" 1e-12
-python3 scripts/timed-commands.py partition_plan --by "bash scripts/mpi-runs.sh" -- \
+python3 scripts/timed-commands.py partition_plan --by "bash scripts/mpi-runs.sh" \
+  --label "\`peritherm partition cases/large/plate_1e7.toml --ranks 4096\`" -- \
   "$serial partition cases/large/plate_1e7.toml --ranks 4096 > /dev/null"
 bash scripts/update-docs.sh
