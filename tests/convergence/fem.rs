@@ -8,7 +8,7 @@
 use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
-use crate::common::figures::Table;
+use crate::common::figures::{rate_list, sci_list, Table, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::fem::run;
 use peritherm::fem::shape::shape;
@@ -919,10 +919,16 @@ fn symmetric_steady_states_converge_at_second_order() {
             .map(|n| steady_error(text, (b - a) / n, exact.as_ref()))
             .collect();
         let r = rates(&errors);
-        eprintln!(
-            "{what}: h = (b − a)/20 … /160, max nodal error {} °C, rates {r:.3?}",
-            sci(&errors)
-        );
+        let cells = [
+            format!("FEM {what}, h = (b − a)/20 … /160"),
+            format!(
+                "max nodal error {} °C, rates {}",
+                sci_list(&errors, 2),
+                rate_list(&r)
+            ),
+            "rates ≥ 1.8".into(),
+        ];
+        SYMMETRY_CHECKS.row(&cells.each_ref().map(String::as_str), FEM_REL_TOL);
         assert!(
             r.iter().all(|&x| x >= 1.8),
             "{what}: rates {r:?}, errors {errors:?}"
@@ -977,11 +983,18 @@ fn sphere_converges_at_second_order() {
         centre.push(c0);
     }
     let (rb, rc) = (rates(&bulk), rates(&centre));
-    eprintln!(
-        "sphere (axisymmetric phase-change paper §3.2) t = 10 s, h = R/40 … R/320: max nodal error at r ≥ R/10 {} K, rates {rb:.3?}; at the centre {} K, rates {rc:.3?}",
-        sci(&bulk),
-        sci(&centre)
-    );
+    let cells = [
+        "FEM cooling sphere at t = 10 s, h = R/40 … R/320".to_string(),
+        format!(
+            "max nodal error at r ≥ R/10 {} K, rates {}; at the centre {} K, rates {}",
+            sci_list(&bulk, 2),
+            rate_list(&rb),
+            sci_list(&centre, 2),
+            rate_list(&rc)
+        ),
+        "rates ≥ 1.8 at r ≥ R/10, ≥ 1.5 at the centre".into(),
+    ];
+    SYMMETRY_CHECKS.row(&cells.each_ref().map(String::as_str), FEM_REL_TOL);
     assert!(
         rb.iter().all(|&x| x >= 1.8),
         "rates {rb:?}, errors {bulk:?}"
