@@ -179,7 +179,7 @@ fn figures_match_within_a_printed_unit_and_the_tolerance() {
 /// `tests/convergence/fem.rs`.
 pub const SYMMETRY_CHECKS: Table = Table {
     name: "symmetry_checks",
-    command: "PERITHERM_RECORD=1 cargo test --release --test cases symmetry:: && PERITHERM_RECORD=1 cargo test --release --test convergence fem::s",
+    command: "PERITHERM_RECORD=1 cargo test --release --test cases symmetry:: && PERITHERM_RECORD=1 cargo test --release --test convergence -- fem::symmetric_steady fem::sphere_converges",
     columns: &["check", "measured", "criterion"],
     keys: &[
         "PD axisymmetric 1D steady wall, Δ = (b − a)/40, /80, /160",
