@@ -12,6 +12,7 @@ mod common {
     pub mod fd;
     pub mod figures;
     pub mod runs;
+    pub mod tables;
 }
 
 mod bundled;

@@ -13,7 +13,7 @@ const REL_TOL: f64 = 1e-6;
 const ROUND_OFF_TOL: f64 = 10.0;
 
 use crate::common::case::CaseToml;
-use crate::common::figures::{rate_list, sci_list, SYMMETRY_CHECKS};
+use crate::common::tables::{rate_list, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};

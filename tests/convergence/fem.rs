@@ -8,7 +8,8 @@
 use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
-use crate::common::figures::{rate_list, sci_list, Table, SYMMETRY_CHECKS};
+use crate::common::figures::Table;
+use crate::common::tables::{rate_list, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::fem::run;
 use peritherm::fem::shape::shape;

@@ -15,6 +15,7 @@ mod common {
     pub mod fd;
     pub mod figures;
     pub mod heat_fd;
+    pub mod tables;
 }
 
 mod fem;
