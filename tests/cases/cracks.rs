@@ -262,7 +262,7 @@ fn crack_plate_matches_finite_differences() {
     );
     let rows = [(at_half, "1"), (at_steady, "1"), (moved, "above 2")];
     for (key, (v, bound)) in CRACK_FD.keys.iter().zip(rows) {
-        CRACK_FD.row(&[key, &format!("{v:.3}"), bound], FD_REL_TOL);
+        CRACK_FD.row(&[key, format!("{v:.3}").as_str(), bound], FD_REL_TOL);
     }
     // the heat flux (columns qx, qy) is finite everywhere and at the tips a few times the
     // far-field flux k·200 °C/2 cm = 1.14e6 W/m² (measured: 3.9e6 at the node by the tip)

@@ -382,24 +382,24 @@ fn per_solve_direct_vs_cg() {
             st.run(&mut theta, 0.0, dt, &end, |_, _, _, _| Ok(()), |_| {})
                 .unwrap();
             let s = st.stats;
+            // CG factorises nothing
+            let (fill, factorising) = match solver {
+                Solver::Cg => ("-".into(), "-".into()),
+                _ => (
+                    format!("{:.3e}", s.factor_entries as f64),
+                    format!("{:.2}", s.factor_seconds),
+                ),
+            };
             let cells = [
                 format!("{file}, {name}"),
                 format!("{dt} s"),
                 st.system().len().to_string(),
-                // CG factorises nothing
-                match solver {
-                    Solver::Cg => "-".into(),
-                    _ => format!("{:.3e}", s.factor_entries as f64),
-                },
-                match solver {
-                    Solver::Cg => "-".into(),
-                    _ => format!("{:.2}", s.factor_seconds),
-                },
+                fill,
+                factorising,
                 s.solves.to_string(),
                 format!("{:.4}", s.solve_seconds / s.solves as f64),
                 s.cg_iterations.to_string(),
             ];
-            let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
             SOLVERS.row(&cells, SOLVERS_REL_TOL);
         }
     }
@@ -439,7 +439,6 @@ fn asymmetry_of_a() {
             format!("{:.1e}", sys.asymmetry),
             if sys.symmetric { "yes" } else { "no" }.to_string(),
         ];
-        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
         // the asymmetry is a property of the model: the same bits on any machine up to `exp`
         ASYMMETRY.row(&cells, 0.01);
     }
@@ -820,7 +819,6 @@ fn adaptive_auto_vs_direct() {
             format!("{:.2}", s.factor_seconds),
             format!("{:.2}", started.elapsed().as_secs_f64()),
         ];
-        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
         SOLVER_CHOICE.row(&cells, IMPLICIT_REL_TOL);
     }
 }

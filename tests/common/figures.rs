@@ -32,9 +32,9 @@ impl Table {
     /// committed one, plus one unit of its last printed digit (a figure that moves across a
     /// rounding boundary by round-off). `rel_tol` is the test's statement of how much the figure
     /// may move on another machine.
-    pub fn row(&self, cells: &[&str], rel_tol: f64) {
+    pub fn row(&self, cells: &[impl AsRef<str>], rel_tol: f64) {
         assert_eq!(cells.len(), self.columns.len(), "{}: cells", self.name);
-        let cells: Vec<String> = cells.iter().map(|c| c.to_string()).collect();
+        let cells: Vec<String> = cells.iter().map(|c| c.as_ref().to_string()).collect();
         let key = cells[0].clone();
         assert!(
             self.keys.contains(&key.as_str()),

@@ -43,3 +43,8 @@ pub fn rate_list(v: &[f64]) -> String {
     let s: Vec<String> = v.iter().map(|x| format!("{x:.2}")).collect();
     s.join(", ")
 }
+
+/// Observed rates log2(e_k / e_{k+1}) of errors at halved spacings.
+pub fn rates(errors: &[f64]) -> Vec<f64> {
+    errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}

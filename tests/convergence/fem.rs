@@ -9,7 +9,7 @@ use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
 use crate::common::figures::Table;
-use crate::common::tables::{rate_list, sci_list, SYMMETRY_CHECKS};
+use crate::common::tables::{rate_list, rates, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::fem::run;
 use peritherm::fem::shape::shape;
@@ -56,7 +56,7 @@ fn record_rates(key: usize, errors: &[f64], rates: &[f64]) {
     let rs: Vec<String> = rates.iter().map(|r| format!("{r:.2}")).collect();
     let result = format!(
         "max nodal error {} °C: rates **{}**",
-        sci(errors),
+        sci_list(errors, 3),
         rs.join(", ")
     );
     let cells = [FEM_CHECKS.keys[key], &result, "every rate ≥ 1.8"];
@@ -121,17 +121,6 @@ fn max_error(c: &Case, h: f64, end: f64, n: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Numbers in scientific notation, for messages.
-fn sci(v: &[f64]) -> String {
-    let s: Vec<String> = v.iter().map(|x| format!("{x:.3e}")).collect();
-    s.join(", ")
-}
-
-/// Observed rates log2(e_k / e_{k+1}) of errors at halved mesh sizes.
-fn rates(errors: &[f64]) -> Vec<f64> {
-    errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
-}
-
 const SQUARE: &str = r#"
 dimension = 2
 [domain]
@@ -184,7 +173,7 @@ fn square_converges_at_second_order() {
         .map(|n| max_error(&c, 1.0 / n, 0.05, 500))
         .collect();
     let r = rates(&errors);
-    eprintln!("square (Bobaru & Duangpanya 2012 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci(&errors));
+    eprintln!("square (Bobaru & Duangpanya 2012 Ex. 1) t = 0.05 s, h = 1/8, 1/16, 1/32: max nodal error {} °C, rates {r:.3?}", sci_list(&errors, 3));
     assert!(
         r.iter().all(|&x| x >= 1.8),
         "rates {r:?}, errors {errors:?}"
@@ -217,7 +206,7 @@ fn bar_converges_at_second_order() {
     let r = rates(&errors);
     eprintln!(
         "bar (Bobaru & Duangpanya 2010 Ex. 1) t = 4 s, h = L/10 … L/80: max nodal error {} °C, rates {r:.3?}",
-        sci(&errors)
+        sci_list(&errors, 3)
     );
     assert!(
         r.iter().all(|&x| x >= 1.8),
@@ -805,7 +794,7 @@ fn time_dependent_held_end_converges_at_second_order() {
     let r = rates(&errors);
     eprintln!(
         "bar with a held end at 5t·e^(−2t) (Wang, Oterkus & Oterkus §4.2 in 1D), t = 3 s, h = L/20, L/40, L/80: max nodal error {} °C, rates {r:.3?}",
-        sci(&errors)
+        sci_list(&errors, 3)
     );
     assert!(
         r.iter().all(|&x| x >= 1.8),
@@ -929,7 +918,7 @@ fn symmetric_steady_states_converge_at_second_order() {
             ),
             "rates ≥ 1.8".into(),
         ];
-        SYMMETRY_CHECKS.row(&cells.each_ref().map(String::as_str), FEM_REL_TOL);
+        SYMMETRY_CHECKS.row(&cells, FEM_REL_TOL);
         assert!(
             r.iter().all(|&x| x >= 1.8),
             "{what}: rates {r:?}, errors {errors:?}"
@@ -995,7 +984,7 @@ fn sphere_converges_at_second_order() {
         ),
         "rates ≥ 1.8 at r ≥ R/10, ≥ 1.5 at the centre".into(),
     ];
-    SYMMETRY_CHECKS.row(&cells.each_ref().map(String::as_str), FEM_REL_TOL);
+    SYMMETRY_CHECKS.row(&cells, FEM_REL_TOL);
     assert!(
         rb.iter().all(|&x| x >= 1.8),
         "rates {rb:?}, errors {bulk:?}"

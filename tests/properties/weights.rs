@@ -292,19 +292,10 @@ const EVERY_MESH: Table = Table {
 /// its last bit and an iteration count may then move by one or two.
 const EVERY_MESH_REL_TOL: f64 = 0.05;
 
-/// Forgets the process's peak resident set so far (Linux; elsewhere a no-op).
+/// Forgets the process's peak resident set so far, so that [`peritherm::bench::peak_rss`]
+/// measures from here (Linux; elsewhere a no-op).
 fn reset_peak_resident() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// The process's peak resident set since [`reset_peak_resident`], in GB (Linux), or "-".
-fn peak_resident_gb() -> String {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let kb = status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok());
-    kb.map_or("-".into(), |kb| format!("{:.1}", kb * 1024.0 / 1e9))
 }
 
 /// Builds every mesh in `files` with the default settings; none may be refused, and every
@@ -331,11 +322,10 @@ fn assert_none_refused(files: &[PathBuf]) {
             format!("{:.1e} .. {:.1e}", c.min_ratio, c.max_ratio),
             format!("{} / {}", c.newton, c.iterations),
             format!("{seconds:.0}"),
-            peak_resident_gb(),
+            peritherm::bench::peak_rss().map_or("-".into(), |b| format!("{:.1}", b as f64 / 1e9)),
             format!("{:.1}", estimate / 1e9),
         ];
         eprintln!("{}", cells.join(" | "));
-        let cells: Vec<&str> = cells.iter().map(String::as_str).collect();
         EVERY_MESH.row(&cells, EVERY_MESH_REL_TOL);
     }
 }
