@@ -5,7 +5,8 @@
 # Markdown table of docs/mesh-convergence.md (and prints it): nodes, h = (V/N)^(1/d) measured,
 # the volume-weighted relative L2 error of PD, its observed rate log(e_{l-1}/e_l)/log(h_{l-1}/h_l),
 # the FEM error on the same mesh, the ratio PD/FEM, and the rate fitted by `peritherm sweep`
-# (least squares of log e against log h over all levels).
+# (least squares of log e against log h over all levels); the table also goes into the figure
+# file validation/<DOC's name>.json, which the README shows (scripts/update-docs.sh).
 # Usage (from the repository root): bash scripts/mesh-convergence.sh
 #   LEVELS="1 2 3" FAMILIES="rect_tri disc" OUT=out/mesh-convergence DOC=docs/mesh-convergence.md
 #   PERITHERM=target/release/peritherm   (skip the build, use this binary)
@@ -36,8 +37,11 @@ for fam in $FAMILIES; do
   echo "$fam done" >&2
 done
 python3 - "$OUT" "$DOC" "$LEVELS" $FAMILIES <<'PY'
-import csv, json, math, re, subprocess, sys
+import csv, json, math, os, re, subprocess, sys
+sys.path.insert(0, "scripts")
+import figure_file
 out, doc, levels, families = sys.argv[1], sys.argv[2], sys.argv[3].split(), sys.argv[4:]
+table = []
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
                         text=True).stdout.strip()
 lines = [
@@ -70,8 +74,9 @@ for fam in families:
         if prev:
             rate = f"{math.log(prev[1] / e) / math.log(prev[0] / h):.2f}"
             frate = f"{math.log(prev[2] / fe) / math.log(prev[0] / h):.2f}"
-        lines.append(f"| {fam} | L{l} | {r['nodes']} | {h:.3e} | {e:.3e} | {rate} | "
-                     f"{fem['nodes']} | {fe:.3e} | {frate} | {e / fe:.1f} |")
+        table.append([fam, f"L{l}", r["nodes"], f"{h:.3e}", f"{e:.3e}", rate,
+                      str(fem["nodes"]), f"{fe:.3e}", frate, f"{e / fe:.1f}"])
+        lines.append("| " + " | ".join(table[-1]) + " |")
         prev = (h, e, fe)
     md = open(f"{out}/{fam}/sweep.md").read()
     m = re.search(r"\| convergence_h_t\d+ \| relative L2 \| (-?[0-9.]+|NaN|inf) \|", md)
@@ -81,4 +86,10 @@ lines += ["", "Rates fitted by `peritherm sweep` over all levels (relative L2 ag
 text = "\n".join(lines) + "\n"
 open(doc, "w").write(text)
 print(text)
+# the same table as a figure file (the README shows it): validation/<the page's name>.json
+name = os.path.splitext(os.path.basename(doc))[0].replace("-", "_")
+columns = [c.strip() for c in lines[4].strip("|").split("|")]
+command = (f'LEVELS="{" ".join(levels)}" FAMILIES="{" ".join(families)}" DOC={doc} '
+           "bash scripts/mesh-convergence.sh")
+figure_file.write(name, command, columns, table)
 PY
