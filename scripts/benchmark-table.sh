@@ -25,4 +25,5 @@ for n in "${names[@]}"; do
 done
 "$bin" table "${dirs[@]}" --json validation/accuracy.json \
   --command "scripts/benchmark-table.sh"
+python3 scripts/papers-table.py
 bash scripts/update-docs.sh

@@ -28,15 +28,16 @@ def provenance(threads=None):
     }
 
 
-def write(name, command, columns, rows, threads=None):
-    """Writes validation/<name>.json (run from the repository root)."""
+def write(name, command, columns, rows, threads=None, checks=None):
+    """Writes validation/<name>.json (run from the repository root); `checks` are what
+    scripts/check-figures.sh reruns (scripts/study.py makes them), none by default."""
     figures = {
         "name": name,
         "command": command,
         "provenance": provenance(threads),
         "columns": columns,
         "rows": rows,
-        "checks": [],
+        "checks": checks or [],
     }
     tmp = f"validation/{name}.json.tmp"
     with open(tmp, "w") as f:
