@@ -16,5 +16,6 @@ mod common {
 mod boundary;
 mod gmsh;
 mod mesh;
+mod modules;
 mod operator;
 mod weights;

@@ -2,6 +2,7 @@
 //! implemented by the explicit, enthalpy and implicit steppers, and the loops over the output
 //! times ([`march`], [`integrate`]).
 
+pub mod engine;
 pub mod enthalpy;
 pub mod exchange;
 pub mod explicit;
@@ -9,5 +10,6 @@ pub mod implicit;
 pub mod integrator;
 pub mod stepper;
 
+pub use engine::{integrate, Engine, Schedule};
 pub use integrator::{choose_dt, count_steps, steps_between, Integrator};
-pub use stepper::{check_finite, integrate, march, Engine, RunStats, Schedule, Stepper};
+pub use stepper::{check_finite, march, RunStats, Stepper};
