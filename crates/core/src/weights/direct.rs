@@ -19,6 +19,26 @@ use rayon::prelude::*;
 /// The set-up's memory estimate counts the factor ([`crate::budget::estimate`]).
 const MAX_ENTRIES: usize = crate::limits::MAX_DIRECT_ENTRIES as usize;
 
+/// Fraction of the machine's available memory (read when the structure is analysed) that the
+/// factorisation may take; a larger factor is left to CG, slower but within memory, since
+/// the set-up's estimate can only guess the factor's fill before the cloud exists.
+const FACTOR_MEMORY_FRACTION: f64 = 0.9;
+
+/// [`FACTOR_MEMORY_FRACTION`] of the machine's available memory now, bytes (None where it
+/// cannot be read).
+pub(super) fn machine_room() -> Option<f64> {
+    let available = crate::budget::Memory::of_machine().available;
+    available.map(|a| a * FACTOR_MEMORY_FRACTION)
+}
+
+/// Bytes of a factorisation of H: the factor's values, H's row indices and values
+/// (`entries`) and faer's scratch (`scratch` bytes).
+fn factor_bytes(symbolic: &SymbolicCholesky<usize>, entries: usize, scratch: usize) -> f64 {
+    let value = std::mem::size_of::<Real>();
+    let index = std::mem::size_of::<usize>();
+    (symbolic.len_val() * value + entries * (value + index) + scratch) as f64
+}
+
 /// The lower triangle of H in compressed columns, and its Cholesky factor.
 pub(super) struct Direct {
     /// Used moment components.
@@ -35,8 +55,11 @@ pub(super) struct Direct {
 }
 
 impl Direct {
-    /// The structure of H for the selection of `p`, analysed once; None when it is too large.
+    /// The structure of H for the selection of `p`, analysed once; None when it is too large
+    /// (more than [`MAX_ENTRIES`], in 3D, or a factor above `p.factor_room` bytes, by default
+    /// [`machine_room`]): the callers then take CG.
     pub(super) fn new(p: &Problem) -> Option<Direct> {
+        let room = p.factor_room;
         let comps: Vec<usize> = (0..super::NC).filter(|&c| p.used[c] != 0.0).collect();
         let nu = comps.len();
         let nodes: Vec<u32> = (0..p.n() as u32).filter(|&i| p.sel[i as usize]).collect();
@@ -75,11 +98,13 @@ impl Direct {
         )
         .ok()?;
         let par = faer::get_global_parallelism();
-        let scratch = MemBuffer::new(
-            symbolic
-                .factorize_numeric_llt_scratch::<Real>(par, Default::default())
-                .or(symbolic.solve_in_place_scratch::<Real>(1, par)),
-        );
+        let scratch = symbolic
+            .factorize_numeric_llt_scratch::<Real>(par, Default::default())
+            .or(symbolic.solve_in_place_scratch::<Real>(1, par));
+        if room.is_some_and(|r| factor_bytes(&symbolic, row_idx.len(), scratch.size_bytes()) > r) {
+            return None;
+        }
+        let scratch = MemBuffer::new(scratch);
         Some(Direct {
             comps,
             pos,

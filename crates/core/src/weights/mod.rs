@@ -118,6 +118,8 @@ struct Problem<'a> {
     target: Vec<Mom>,
     /// Scale of node i's moments (its diagonal target, or 1), for the relative error.
     unit: Vec<Real>,
+    /// Bytes a direct factorisation of the Newton matrix may take (None: no limit known).
+    factor_room: Option<Real>,
 }
 
 /// φ(ξ) scaled by the node's horizon s: (ξ/s, vech(ξξᵀ)/s²), masked to the used components.
@@ -190,6 +192,7 @@ impl<'a> Problem<'a> {
             used: used_components(dim, order),
             target,
             unit: Vec::new(),
+            factor_room: None,
         };
         // unit of node i: its diagonal target second moment, or (linear) the present one
         p.unit = (0..n)
@@ -258,6 +261,7 @@ impl<'a> Problem<'a> {
             used: self.used,
             target,
             unit: self.unit.clone(),
+            factor_room: self.factor_room,
         }
     }
 
@@ -644,8 +648,24 @@ pub fn correct(
     conductivity: &[Real],
     order: Order,
 ) -> (Consistency, Vec<bool>) {
+    let room = direct::machine_room();
+    correct_within(k, cloud, sel, conductivity, order, room)
+}
+
+/// [`correct`] with `factor_room` bytes for a direct factorisation of the Newton matrix
+/// (None: no limit); a factor that would not fit is left to CG, which reaches the same
+/// weights more slowly.
+pub fn correct_within(
+    k: &mut Conductance,
+    cloud: &Cloud,
+    sel: &[bool],
+    conductivity: &[Real],
+    order: Order,
+    factor_room: Option<Real>,
+) -> (Consistency, Vec<bool>) {
     let whole_cloud = k.vals.len() <= WHOLE_PAIRS;
     let mut p = Problem::new(k, cloud, sel, conductivity, order);
+    p.factor_room = factor_room;
     let mut out = Consistency {
         before: p.worst(&p.residual(&p.k0)),
         min_ratio: 1.0,
