@@ -12,10 +12,8 @@ PERITHERM="$bin" python3 - <<'PY'
 import json
 import sys
 sys.path.insert(0, "scripts")
-from study import Study
+from study import FEM_REL_TOL as TOL, Study
 
-# 1e-6 relative: the FEM's round-off depends on the order of its threaded assembly.
-TOL = 1e-6
 s = Study("fem_bars", "bash scripts/fem-bars.sh", "out/fem-bars")
 runs = [(c, []) for c in ["bar_dirichlet", "bar_insulated_left", "bar_flux"]]
 runs += [("square_dirichlet", ["--scheme", sch, "--dt", "1e-4"]) for sch in ["crank-nicolson", "backward-euler"]]

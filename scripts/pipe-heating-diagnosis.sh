@@ -15,11 +15,8 @@ PERITHERM="$bin" python3 - <<'PY'
 import json
 import sys
 sys.path.insert(0, "scripts")
-from study import Study
+from study import FEM_REL_TOL as TOL, Study
 
-# 1e-6 relative: ε and the FEM energies carry the FEM's round-off, which depends on the order
-# of its threaded assembly.
-TOL = 1e-6
 CHANGES = [None, "time.dt=2", "kernel.profile=conical", "kernel.p=1",
            "kernel.partial_volume=all_or_nothing", "symmetry=planar"]
 s = Study("pipe_heating_diagnosis", "bash scripts/pipe-heating-diagnosis.sh",

@@ -10,6 +10,10 @@ import sys
 
 import figure_file
 
+# Relative tolerance of a figure that carries the built-in FEM's round-off, which depends on
+# the order of its threaded assembly (far below 1e-6 of any figure a study tables).
+FEM_REL_TOL = 1e-6
+
 
 def fnv1a_hex(data):
     """FNV-1a, 64 bits, hexadecimal, as `peritherm_post::figures::fnv1a_hex`."""
