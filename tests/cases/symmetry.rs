@@ -13,7 +13,7 @@ const REL_TOL: f64 = 1e-6;
 const ROUND_OFF_TOL: f64 = 10.0;
 
 use crate::common::case::CaseToml;
-use crate::common::tables::{rate_list, rates, sci_list, SYMMETRY_CHECKS};
+use crate::common::tables::{errors_and_rates, rates, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
@@ -102,11 +102,7 @@ fn steady_radial_states_converge_at_second_order() {
         let r = rates(&errors);
         let cells = [
             format!("PD {symmetry} {dim}D steady wall, Δ = (b − a)/40, /80, /160"),
-            format!(
-                "max nodal error {} °C, rates {}",
-                sci_list(&errors, 2),
-                rate_list(&r)
-            ),
+            format!("max nodal error {}", errors_and_rates(&errors, " °C")),
             "rates ≥ 1.8, finest < 0.05 °C".into(),
         ];
         SYMMETRY_CHECKS.row(&cells, REL_TOL);
@@ -239,7 +235,7 @@ fn sphere_cools_as_the_series() {
         let r = rates(&e);
         let cells = [
             format!("PD cooling sphere, ε against the series at t = {t} s, Δ = R/20, R/40, R/80"),
-            format!("ε {}, rates {}", sci_list(&e, 2), rate_list(&r)),
+            format!("ε {}", errors_and_rates(&e, "")),
             "rates ≥ 1.8, ε < 5e-3".into(),
         ];
         SYMMETRY_CHECKS.row(&cells, REL_TOL);

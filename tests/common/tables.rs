@@ -44,6 +44,13 @@ pub fn rate_list(v: &[f64]) -> String {
     s.join(", ")
 }
 
+/// Errors at halved spacings with their observed rates, the cell of every convergence row:
+/// `a, b, c UNIT, rates x, y` (`unit` with its leading space, or empty).
+pub fn errors_and_rates(errors: &[f64], unit: &str) -> String {
+    let r = rates(errors);
+    format!("{}{unit}, rates {}", sci_list(errors, 2), rate_list(&r))
+}
+
 /// Observed rates log2(e_k / e_{k+1}) of errors at halved spacings.
 pub fn rates(errors: &[f64]) -> Vec<f64> {
     errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()

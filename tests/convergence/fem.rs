@@ -9,7 +9,7 @@ use crate::common::case::CaseToml;
 use crate::common::cli::{peritherm, write_case};
 use crate::common::fd::CrackPlate;
 use crate::common::figures::Table;
-use crate::common::tables::{rate_list, rates, sci_list, SYMMETRY_CHECKS};
+use crate::common::tables::{errors_and_rates, rate_list, rates, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::fem::run;
 use peritherm::fem::shape::shape;
@@ -53,11 +53,10 @@ const FEM_REL_TOL: f64 = 1e-6;
 
 /// Records the row `key` of [`FEM_CHECKS`] for errors at halved mesh sizes and their rates.
 fn record_rates(key: usize, errors: &[f64], rates: &[f64]) {
-    let rs: Vec<String> = rates.iter().map(|r| format!("{r:.2}")).collect();
     let result = format!(
         "max nodal error {} °C: rates **{}**",
         sci_list(errors, 3),
-        rs.join(", ")
+        rate_list(rates)
     );
     let cells = [FEM_CHECKS.keys[key], &result, "every rate ≥ 1.8"];
     FEM_CHECKS.row(&cells, FEM_REL_TOL);
@@ -911,11 +910,7 @@ fn symmetric_steady_states_converge_at_second_order() {
         let r = rates(&errors);
         let cells = [
             format!("FEM {what}, h = (b − a)/20 … /160"),
-            format!(
-                "max nodal error {} °C, rates {}",
-                sci_list(&errors, 2),
-                rate_list(&r)
-            ),
+            format!("max nodal error {}", errors_and_rates(&errors, " °C")),
             "rates ≥ 1.8".into(),
         ];
         SYMMETRY_CHECKS.row(&cells, FEM_REL_TOL);
@@ -976,11 +971,9 @@ fn sphere_converges_at_second_order() {
     let cells = [
         "FEM cooling sphere at t = 10 s, h = R/40 … R/320".to_string(),
         format!(
-            "max nodal error at r ≥ R/10 {} K, rates {}; at the centre {} K, rates {}",
-            sci_list(&bulk, 2),
-            rate_list(&rb),
-            sci_list(&centre, 2),
-            rate_list(&rc)
+            "max nodal error at r ≥ R/10 {}; at the centre {}",
+            errors_and_rates(&bulk, " K"),
+            errors_and_rates(&centre, " K")
         ),
         "rates ≥ 1.8 at r ≥ R/10, ≥ 1.5 at the centre".into(),
     ];
