@@ -59,7 +59,6 @@ impl Direct {
     /// (more than [`MAX_ENTRIES`], in 3D, or a factor above `p.factor_room` bytes, by default
     /// [`machine_room`]): the callers then take CG.
     pub(super) fn new(p: &Problem) -> Option<Direct> {
-        let room = p.factor_room;
         let comps: Vec<usize> = (0..super::NC).filter(|&c| p.used[c] != 0.0).collect();
         let nu = comps.len();
         let nodes: Vec<u32> = (0..p.n() as u32).filter(|&i| p.sel[i as usize]).collect();
@@ -101,7 +100,8 @@ impl Direct {
         let scratch = symbolic
             .factorize_numeric_llt_scratch::<Real>(par, Default::default())
             .or(symbolic.solve_in_place_scratch::<Real>(1, par));
-        if room.is_some_and(|r| factor_bytes(&symbolic, row_idx.len(), scratch.size_bytes()) > r) {
+        let bytes = factor_bytes(&symbolic, row_idx.len(), scratch.size_bytes());
+        if p.factor_room.is_some_and(|room| bytes > room) {
             return None;
         }
         let scratch = MemBuffer::new(scratch);

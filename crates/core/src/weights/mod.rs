@@ -160,13 +160,15 @@ fn used_components(dim: usize, order: Order) -> Mom {
 
 impl<'a> Problem<'a> {
     /// The problem of meeting `order`'s moments at the nodes `sel` of `cloud` for the
-    /// conductances `k` and the conductivities `conductivity` (W/(m·K)).
+    /// conductances `k` and the conductivities `conductivity` (W/(m·K)), with `factor_room`
+    /// bytes for a direct factorisation.
     fn new(
         k: &'a Conductance,
         cloud: &'a Cloud,
         sel: &[bool],
         conductivity: &[Real],
         order: Order,
+        factor_room: Option<Real>,
     ) -> Problem<'a> {
         let n = k.n_rows();
         let dim = cloud.dim;
@@ -192,7 +194,7 @@ impl<'a> Problem<'a> {
             used: used_components(dim, order),
             target,
             unit: Vec::new(),
-            factor_room: None,
+            factor_room,
         };
         // unit of node i: its diagonal target second moment, or (linear) the present one
         p.unit = (0..n)
@@ -664,8 +666,7 @@ pub fn correct_within(
     factor_room: Option<Real>,
 ) -> (Consistency, Vec<bool>) {
     let whole_cloud = k.vals.len() <= WHOLE_PAIRS;
-    let mut p = Problem::new(k, cloud, sel, conductivity, order);
-    p.factor_room = factor_room;
+    let mut p = Problem::new(k, cloud, sel, conductivity, order, factor_room);
     let mut out = Consistency {
         before: p.worst(&p.residual(&p.k0)),
         min_ratio: 1.0,
