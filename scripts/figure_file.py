@@ -28,13 +28,14 @@ def provenance(threads=None):
     }
 
 
-def write(name, command, columns, rows, threads=None, checks=None):
+def write(name, command, columns, rows, threads=None, checks=None, source=None):
     """Writes validation/<name>.json (run from the repository root); `checks` are what
-    scripts/check-figures.sh reruns (scripts/study.py makes them), none by default."""
+    scripts/check-figures.sh reruns (scripts/study.py makes them), none by default; `source`
+    is the provenance of figures read from another figure file (default: this run's)."""
     figures = {
         "name": name,
         "command": command,
-        "provenance": provenance(threads),
+        "provenance": source or provenance(threads),
         "columns": columns,
         "rows": rows,
         "checks": checks or [],

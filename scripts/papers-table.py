@@ -6,6 +6,10 @@ Writes validation/papers.json with the accuracy table's provenance; its checks s
 accuracy.json. Usage: python3 scripts/papers-table.py   (from the repository root)"""
 import json
 import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import figure_file  # noqa: E402
 
 ACCURACY = "validation/accuracy.json"
 
@@ -49,18 +53,8 @@ def main():
         ["Wang, Oterkus & Oterkus §4.5 split thermal shock at 3 s", '"good agreement" with FEM (Figs 29–30, figures only)',
          f"**{cell('thermal_shock_split', 3, 'max abs diff (°C)')}** °C over all nodes against the series"],
     ]
-    figures = {
-        "name": "papers",
-        "command": "python3 scripts/papers-table.py (from validation/accuracy.json)",
-        "provenance": acc["provenance"],
-        "columns": ["benchmark", "paper's figure", "peritherm"],
-        "rows": rows,
-        "checks": [],
-    }
-    tmp = "validation/papers.json.tmp"
-    with open(tmp, "w") as f:
-        f.write(json.dumps(figures, indent=2, ensure_ascii=False) + "\n")
-    os.replace(tmp, "validation/papers.json")
+    figure_file.write("papers", "python3 scripts/papers-table.py (from validation/accuracy.json)",
+                      ["benchmark", "paper's figure", "peritherm"], rows, source=acc["provenance"])
 
 
 if __name__ == "__main__":
