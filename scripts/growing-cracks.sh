@@ -9,8 +9,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/peritherm-bin.sh
 PERITHERM="$bin" python3 - <<'PY'
-import csv
-import json
 import sys
 sys.path.insert(0, "scripts")
 from study import Study
@@ -18,10 +16,8 @@ from study import Study
 POINTS = [(0.0, 0.002), (0.0, -0.002)]  # m: above and below the crossing
 s = Study("growing_cracks", "bash scripts/growing-cracks.sh", "out/growing-cracks")
 args = ["run", "cases/growing_cracks.toml", "--quiet"]
-summary = json.load(open(f"{s.run(args)}/run.json"))
-for t, name in zip(summary["output_times"], summary["fields"]):
-    with open(s.file(args, name)) as f:
-        nodes = [(float(r["x"]), float(r["y"]), float(r["temperature"])) for r in csv.DictReader(f)]
+for t, rows in s.fields(args):
+    nodes = [(float(r["x"]), float(r["y"]), float(r["temperature"])) for r in rows]
     near = [min(nodes, key=lambda n: (n[0] - px) ** 2 + (n[1] - py) ** 2) for px, py in POINTS]
     s.rows.append([f"{t:g}"] + [f"({n[0] * 1e3:.2f}, {n[1] * 1e3:.2f})" for n in near]
                   + [f"{n[2]:.1f}" for n in near])

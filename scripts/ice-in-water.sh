@@ -10,8 +10,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/peritherm-bin.sh
 PERITHERM="$bin" python3 - <<'PY'
-import csv
-import json
 import sys
 sys.path.insert(0, "scripts")
 from study import Study
@@ -21,10 +19,8 @@ T_ICE, T_WATER, T_F = 268.15, 373.15, 273.15  # K
 C_L, C_S, L = 4182.0, 2060.0, 333e3  # J/(kg K), J/(kg K), J/kg
 s = Study("ice_in_water", "bash scripts/ice-in-water.sh", "out/ice-in-water")
 args = ["run", "cases/ice_in_water.toml", "--quiet"]
-summary = json.load(open(f"{s.run(args)}/run.json"))
-for t, name in zip(summary["output_times"], summary["fields"]):
-    with open(s.file(args, name)) as f:
-        rows = [(float(r["volume"]), float(r["temperature"]), r["region"]) for r in csv.DictReader(f)]
+for t, table in s.fields(args):
+    rows = [(float(r["volume"]), float(r["temperature"]), r["region"]) for r in table]
     v_ice = sum(v for v, _, region in rows if region == "0")
     v_all = sum(v for v, _, _ in rows)
     mean = sum(v * theta for v, theta, _ in rows) / v_all

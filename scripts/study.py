@@ -3,6 +3,7 @@ that scripts/check-figures.sh reruns: each figure a row shows is read from a fil
 wrote (a number at a JSON pointer, or a whole field file by its hash), and the same reading is
 recorded as a check. Run from the repository root; the binary is $PERITHERM or
 target/release/peritherm (scripts/peritherm-bin.sh builds it)."""
+import csv
 import json
 import os
 import subprocess
@@ -66,6 +67,15 @@ class Study:
             digest = fnv1a_hex(f.read())
         self.checks.append({"kind": "file", "args": list(args), "file": file, "fnv1a": digest})
         return path
+
+    def fields(self, args):
+        """(t, rows of the field CSV as dicts) at every output of `peritherm ARGS`, each field
+        file's bytes recorded as a check."""
+        with open(os.path.join(self.run(args), "run.json")) as f:
+            summary = json.load(f)
+        for t, name in zip(summary["output_times"], summary["fields"]):
+            with open(self.file(args, name)) as f:
+                yield t, list(csv.DictReader(f))
 
     def write(self, columns):
         """Writes validation/<name>.json."""
