@@ -1,0 +1,5 @@
+// dim: 2
+// Set-up scaling family (issue 33), unit square of gmsh default triangles, level 3 of 4:
+// element size h = 0.003 m (each level halves h, four times the nodes). Geometry: scale_square.inc.
+h = 0.003;
+Include "scale_square.inc";
