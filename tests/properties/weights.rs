@@ -197,6 +197,36 @@ fn a_factor_that_does_not_fit_is_left_to_cg() {
     }
 }
 
+/// The weights are the same bits on 1 and 2 threads, through the direct factor and through
+/// CG alone, in 2D and 3D: every sum of the correction has a fixed order and its
+/// factorisations are sequential (an exact invariant: no tolerance).
+#[test]
+fn consistent_weights_are_the_same_bits_for_any_thread_count() {
+    let wall = "type = \"insulated\"";
+    for (file, dim) in [("moments_tri.msh", 2), ("moments_tet.msh", 3)] {
+        let corrected = model(file, dim, wall, "0", None);
+        let plain = model(file, dim, wall, "0", Some("none"));
+        let solve = |threads: usize, room: Option<f64>| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut k = plain.conductance.clone();
+            let (sel, order) = (&corrected.consistent, Order::Quadratic);
+            pool.install(|| {
+                weights::correct_within(&mut k, &plain.cloud, sel, &plain.conductivity, order, room)
+            });
+            k.vals
+        };
+        for room in [None, Some(0.0)] {
+            assert!(
+                solve(1, room) == solve(2, room),
+                "{file}, factor room {room:?}: 1 and 2 threads differ"
+            );
+        }
+    }
+}
+
 /// The linear order zeroes first moments only: a linear field is steady, a quadratic one is
 /// not integrated exactly (the second moments keep the quadrature bias).
 #[test]

@@ -249,7 +249,7 @@ impl Coarse {
     pub(super) fn new(p: &Problem, vals: &[Real]) -> Option<Coarse> {
         let aggs = Aggregates::new(p)?;
         let e = aggs.matrix(p, vals)?;
-        let par = faer::get_global_parallelism();
+        let par = super::FACTOR_PAR;
         let symbolic = factorize_symbolic_cholesky(
             e.symbolic(),
             Side::Lower,
@@ -287,7 +287,7 @@ impl Coarse {
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             faer::MatMut::from_column_major_slice_mut(&mut c, n, 1),
-            faer::get_global_parallelism(),
+            super::FACTOR_PAR,
             MemStack::new(&mut self.scratch),
         );
         self.aggs.prolong(&c, z);

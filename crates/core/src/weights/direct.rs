@@ -96,7 +96,7 @@ impl Direct {
             Default::default(),
         )
         .ok()?;
-        let par = faer::get_global_parallelism();
+        let par = super::FACTOR_PAR;
         let scratch = symbolic
             .factorize_numeric_llt_scratch::<Real>(par, Default::default())
             .or(symbolic.solve_in_place_scratch::<Real>(1, par));
@@ -172,7 +172,7 @@ impl Direct {
         let structure =
             SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let h = SparseColMatRef::new(structure, &a);
-        let par = faer::get_global_parallelism();
+        let par = super::FACTOR_PAR;
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.values,
@@ -201,7 +201,7 @@ impl Direct {
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             faer::MatMut::from_column_major_slice_mut(&mut rhs, n, 1),
-            faer::get_global_parallelism(),
+            super::FACTOR_PAR,
             MemStack::new(&mut self.scratch),
         );
         x.iter_mut().for_each(|v| *v = Mom::zeros());

@@ -96,6 +96,11 @@ pub struct Consistency {
     pub max_ratio: Real,
 }
 
+/// faer's parallelism in the factorisations of the correction: sequential, because faer's
+/// parallel sparse Cholesky orders its sums by the thread count, and the weights must be the
+/// same bits for any thread count (every other sum of the correction has a fixed order).
+const FACTOR_PAR: faer::Par = faer::Par::Seq;
+
 /// Relative tolerance on every moment component at every corrected node.
 pub const TOLERANCE: Real = 1e-10;
 /// Newton iterations per round before the nodes still far off are left out.
