@@ -19,10 +19,10 @@
 
 pub use peritherm_core::{
     analytic, bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model,
-    neighbors, operator, partition, solve, spatial, stencil, symmetry, weights,
+    neighbors, operator, partition, progress, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{
-    atomic, case, gmsh, history, output, provenance, reference, series, staging,
+    atomic, case, gmsh, history, output, provenance, reference, series, staging, weights_cache,
 };
 pub use peritherm_post::{plot, report};
 

@@ -27,6 +27,15 @@ struct Cli {
     /// available memory); a case estimated above it is refused before it is built.
     #[arg(long, global = true, value_parser = peritherm::budget::parse_bytes)]
     max_memory: Option<f64>,
+    /// Directory of the cache of consistent bond weights, or `off` (default:
+    /// $PERITHERM_CACHE, else ~/.cache/peritherm/weights): a run that changes nothing the
+    /// weights depend on loads them instead of computing them again.
+    #[arg(long, global = true, value_name = "DIR")]
+    cache: Option<PathBuf>,
+    /// Largest size of the weights cache, e.g. 2G (default: $PERITHERM_CACHE_SIZE, else 4G);
+    /// the least recently used entries go first.
+    #[arg(long, global = true, value_name = "BYTES", value_parser = peritherm::budget::parse_bytes)]
+    cache_size: Option<f64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -268,8 +277,12 @@ fn main() -> ExitCode {
 fn real_main(cli: Cli) -> anyhow::Result<()> {
     // SIGINT/SIGTERM: the run under way leaves a run.json saying so and no partial file
     ctrlc::set_handler(|| peritherm::staging::interrupt()).context("signal handler")?;
+    let cache =
+        peritherm::weights_cache::WeightsCache::configured(cli.cache.as_deref(), cli.cache_size)
+            .map_err(anyhow::Error::msg)?;
     let options = peritherm::prepare::Options {
         max_memory: cli.max_memory,
+        cache: cache.map(std::sync::Arc::new),
     };
     if let Some(n) = cli.threads {
         rayon::ThreadPoolBuilder::new()
@@ -331,7 +344,7 @@ fn dispatch(
         } => {
             let figures = json.map(|path| (path, command));
             let against = peritherm::sweep::Against::chosen(against, against_first);
-            sweep(&cases, &vary, &out, against, exclude_tips, figures)
+            sweep(&cases, &vary, &out, against, exclude_tips, figures, options)
         }
         Command::Bench {
             quick,
@@ -431,13 +444,73 @@ fn run(
     refuse_as_ranks()?;
     let case = peritherm::sweep::load_with(path, set)?;
     let bar = step_bar(quiet);
+    let setup = SetupBar::new(quiet);
     let summary = run_case_with(&case, out, options, |done, total| {
+        setup.stepping(&bar);
         bar.set_length(total);
         bar.set_position(done);
-    })?;
+    });
+    setup.stepping(&bar);
+    let summary = summary?;
     bar.finish_and_clear();
     print_run(&case, &summary, out);
     Ok(())
+}
+
+/// The set-up's progress on a terminal (the consistent weights' Newton steps and residual),
+/// until the first step; then the step bar's clock starts, so its elapsed time and ETA count
+/// the stepping only.
+struct SetupBar {
+    bar: ProgressBar,
+    done: std::cell::Cell<bool>,
+}
+
+impl SetupBar {
+    fn new(quiet: bool) -> SetupBar {
+        let bar = ProgressBar::new_spinner();
+        if quiet || !std::io::stderr().is_terminal() {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} set-up {elapsed_precise}  {msg}")
+                .expect("valid template"),
+        );
+        bar.set_message("reading and building the cloud");
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        let shown = bar.clone();
+        let sink = move |e: &peritherm::progress::Event| {
+            use peritherm::progress::Event;
+            let msg = match *e {
+                Event::WeightsStart { nodes, pairs } => {
+                    format!("consistent weights of {nodes} nodes, {pairs} pairs")
+                }
+                Event::Newton {
+                    step,
+                    residual,
+                    iterations,
+                } => format!(
+                    "consistent weights: Newton step {step}, moment residual {residual:.1e} (to {:.0e}), {iterations} CG iterations so far",
+                    peritherm::weights::TOLERANCE
+                ),
+                Event::WeightsLoaded => "consistent weights loaded from the cache".into(),
+            };
+            shown.set_message(msg);
+        };
+        peritherm::progress::set_sink(Some(std::sync::Arc::new(sink)));
+        SetupBar {
+            bar,
+            done: std::cell::Cell::new(false),
+        }
+    }
+
+    /// Ends the set-up display (once) and starts the step bar's clock.
+    fn stepping(&self, steps: &ProgressBar) {
+        if !self.done.replace(true) {
+            peritherm::progress::set_sink(None);
+            self.bar.finish_and_clear();
+            steps.reset();
+        }
+    }
 }
 
 /// `peritherm run` as one rank of `mpiexec -n N` (or a singleton, N = 1): each rank takes its
@@ -462,10 +535,14 @@ fn run_mpi(
         .build_global();
     let case = peritherm::sweep::load_with(path, set)?;
     let bar = step_bar(quiet || !root);
+    let setup = SetupBar::new(quiet || !root);
     let summary = env.run(&case, out, options, |done, total| {
+        setup.stepping(&bar);
         bar.set_length(total);
         bar.set_position(done);
-    })?;
+    });
+    setup.stepping(&bar);
+    let summary = summary?;
     bar.finish_and_clear();
     if let Some(summary) = summary {
         print_run(&case, &summary, out);
@@ -523,6 +600,17 @@ fn print_run(case: &Case, summary: &RunSummary, out: &std::path::Path) {
         summary.wall_seconds,
         out.display()
     );
+    if let Some(c) = &summary.consistency {
+        let how = match c.reused {
+            true => "loaded from the weights cache".to_string(),
+            false => format!("{} Newton steps, {} CG iterations", c.newton, c.iterations),
+        };
+        say!(
+            "  consistent weights at {} nodes: {how}; set-up {:.2} s",
+            c.corrected,
+            summary.setup_seconds
+        );
+    }
     if let Some(st) = &summary.implicit {
         say!(
             "  {} accepted and {} rejected steps ({:.3e} to {:.3e} s), {} solves ({} by CG), {} factorisations",
@@ -781,6 +869,7 @@ fn sweep(
     against: Option<peritherm::sweep::Against>,
     exclude_tips: f64,
     figures: Option<(PathBuf, String)>,
+    options: &peritherm::prepare::Options,
 ) -> anyhow::Result<()> {
     use peritherm::sweep;
     // a sweep against a run directory cannot be repeated by its arguments alone
@@ -792,9 +881,16 @@ fn sweep(
     }
     let (variants, against) = sweep::study(cases, vary, against)?;
     let n = variants.len();
-    let rows = sweep::run(&variants, out, &against, exclude_tips, |k, label| {
-        eprintln!("[{}/{n}] {label}", k + 1);
-    })?;
+    let rows = sweep::run(
+        &variants,
+        out,
+        &against,
+        exclude_tips,
+        options,
+        |k, label| {
+            eprintln!("[{}/{n}] {label}", k + 1);
+        },
+    )?;
     let (table, _) = sweep::write_study(&variants, &rows, out, &against)?;
     say!("{table}");
     say!("-> {}", out.join("sweep.md").display());

@@ -11,12 +11,29 @@ use crate::model::{Geometry, Model};
 use crate::solve::exchange::{Collective, RankPlan, Reduce};
 use crate::solve::implicit::{symmetric_over, Adaptive};
 use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
+use crate::weights::store::Store;
+use crate::weights_cache::WeightsCache;
+use std::sync::Arc;
 
 /// Settings of a run that are not part of the case.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct Options {
     /// Memory a run may plan to use, bytes (None: a fraction of the machine's available).
     pub max_memory: Option<f64>,
+    /// Where consistent weights are kept between runs (None: always computed).
+    pub cache: Option<Arc<WeightsCache>>,
+}
+
+impl Options {
+    /// The weights store of a process that keeps new weights (`writes`) or only reads them.
+    fn store(&self, writes: bool) -> Option<WeightsCache> {
+        let cache = self.cache.as_deref()?;
+        Some(if writes {
+            cache.clone()
+        } else {
+            cache.reading()
+        })
+    }
 }
 
 /// The time loop a run will execute, validated.
@@ -54,10 +71,17 @@ pub fn keyed(case: &Case, e: Error) -> Error {
 
 /// Checks the budget, builds the model and runs the semantic checks on it.
 pub fn build(case: &Case, options: &Options) -> Result<Model> {
+    build_keeping(case, options, true)
+}
+
+/// [`build`], keeping newly computed weights in the cache only when `writes`.
+fn build_keeping(case: &Case, options: &Options, writes: bool) -> Result<Model> {
     case.budget
         .enforce(options.max_memory)
         .map_err(|message| case.error(&case.budget.key, message))?;
-    let model = Model::build(&case.spec).map_err(|e| keyed(case, e))?;
+    let store = options.store(writes);
+    let store = store.as_ref().map(|s| s as &dyn Store);
+    let model = Model::build_with(&case.spec, store).map_err(|e| keyed(case, e))?;
     semantic(case, &model).map_err(|e| keyed(case, e))?;
     Ok(model)
 }
@@ -169,7 +193,8 @@ pub fn build_rank(
 
 /// The whole model on this rank, with its plan computed as every rank computes it.
 fn whole_rank(case: &Case, options: &Options, link: &dyn Collective) -> Result<(Model, RankPlan)> {
-    let model = build(case, options)?;
+    // one writer per run: rank 0 keeps the weights, every rank may load them
+    let model = build_keeping(case, options, link.rank() == 0)?;
     let plan = RankPlan::all(&model, link.size()).swap_remove(link.rank());
     Ok((model, plan))
 }

@@ -282,6 +282,15 @@ fn execute(
             (_, w) => w,
         }
     };
+    // the stepping starts: a progress display's clock starts here (set-up and reference excluded)
+    progress(
+        0,
+        if schedule.adaptive.is_some() {
+            0
+        } else {
+            total
+        },
+    );
     let on_step = step_progress(case, &schedule, total, &mut progress);
     let stats = integrate(
         &mut engine,

@@ -10,9 +10,10 @@ use crate::error::{Error, Result};
 use crate::model::crack_cutters;
 use crate::output::{FieldRows, RunSummary};
 use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
+use crate::prepare::Options;
 use crate::report::field_difference;
 use crate::report::page::{probe_lines, ProbeLine};
-use crate::run::run_case;
+use crate::run::run_case_with;
 use std::path::{Path, PathBuf};
 
 /// One `--vary KEY=V1,V2,…`: a dotted key of the case file and the values it takes.
@@ -429,18 +430,20 @@ impl Against {
 
 /// Runs every variant into `out/<label>/` and compares it with `against` at each of its
 /// output times; nodes within `exclude_tips` (m) of a crack tip are left out of field-to-field
-/// comparisons. `progress(k, label)` is called before variant k runs.
+/// comparisons, each run with `options` (the memory budget and the weights cache, so variants
+/// that share a cloud share its weights). `progress(k, label)` is called before variant k runs.
 pub fn run(
     variants: &[Variant],
     out: &Path,
     against: &Against,
     exclude_tips: f64,
+    options: &Options,
     mut progress: impl FnMut(usize, &str),
 ) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (k, v) in variants.iter().enumerate() {
         progress(k, &v.label);
-        let done = VariantRun::run(v, out.join(&v.label), against)?;
+        let done = VariantRun::run(v, out.join(&v.label), against, options)?;
         let reference_dir = match against {
             Against::Reference => {
                 rows.extend(done.reference_rows()?);
@@ -469,7 +472,12 @@ struct VariantRun<'a> {
 impl<'a> VariantRun<'a> {
     /// Runs `v` into `dir`; compared with a run (another or the first), a variant's own
     /// [reference.fem] (solved again for every variant, the measures not using it) is left out.
-    fn run(v: &'a Variant, dir: PathBuf, against: &Against) -> Result<VariantRun<'a>> {
+    fn run(
+        v: &'a Variant,
+        dir: PathBuf,
+        against: &Against,
+        options: &Options,
+    ) -> Result<VariantRun<'a>> {
         let own_fem = v
             .case
             .reference
@@ -478,9 +486,9 @@ impl<'a> VariantRun<'a> {
         let summary = if own_fem && *against != Against::Reference {
             let mut case = v.case.clone();
             case.reference = None;
-            run_case(&case, &dir, |_, _| {})?
+            run_case_with(&case, &dir, options, |_, _| {})?
         } else {
-            run_case(&v.case, &dir, |_, _| {})?
+            run_case_with(&v.case, &dir, options, |_, _| {})?
         };
         let cloud = v.case.spec.geometry.bare_cloud()?;
         let measure: f64 = cloud.volume[..cloud.n_body].iter().sum::<f64>() / cloud.tau;

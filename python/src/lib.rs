@@ -322,6 +322,22 @@ struct State {
     recorded: Vec<Snapshot>,
 }
 
+/// The options of a run from Python: `max_memory` and the weights cache that
+/// `$PERITHERM_CACHE` and `$PERITHERM_CACHE_SIZE` set, as for the command line.
+fn run_options(max_memory: Option<f64>) -> peritherm::Result<peritherm::prepare::Options> {
+    let cache =
+        peritherm::weights_cache::WeightsCache::configured(None, None).map_err(|message| {
+            peritherm::Error::Model {
+                key: "environment".into(),
+                message,
+            }
+        })?;
+    Ok(peritherm::prepare::Options {
+        max_memory,
+        cache: cache.map(Arc::new),
+    })
+}
+
 /// A built model with its temperature, time and integrator.
 #[pyclass(name = "Model", module = "peritherm._peritherm", frozen)]
 struct PyModel {
@@ -334,7 +350,7 @@ struct PyModel {
 impl PyModel {
     /// Builds the model of `case` as a run does (budget, model, semantic checks, plan).
     fn build(case: Arc<Case>, max_memory: Option<f64>) -> peritherm::Result<Self> {
-        let options = peritherm::prepare::Options { max_memory };
+        let options = run_options(max_memory)?;
         let model = Arc::new(peritherm::prepare::build(&case, &options)?);
         // SAFETY: the simulation borrows the model and the case, which live in Arcs owned
         // by this PyModel: their heap addresses never change, they are never mutated, and
@@ -732,7 +748,7 @@ fn run_case<'py>(
         Err(_) => Arc::new(Case::load(&path_arg(case)?).map_err(py_err)?),
     };
     let out = path_arg(out)?;
-    let options = peritherm::prepare::Options { max_memory };
+    let options = run_options(max_memory).map_err(py_err)?;
     let summary = interruptible(py, |check| {
         peritherm::run::run_case_with(&case, &out, &options, |_, _| check())
     })?;
@@ -815,7 +831,10 @@ fn sweep<'py>(
         .collect::<PyResult<_>>()?;
     let (variants, against) = sweep::study(&cases, &vary, against).map_err(py_err)?;
     let (rows, table, csv) = interruptible(py, |check| {
-        let rows = sweep::run(&variants, &out, &against, exclude_tips, |_, _| check())?;
+        let options = run_options(None)?;
+        let rows = sweep::run(&variants, &out, &against, exclude_tips, &options, |_, _| {
+            check()
+        })?;
         let (table, csv) = sweep::write_study(&variants, &rows, &out, &against)?;
         Ok((rows, table, csv))
     })?;

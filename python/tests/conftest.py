@@ -15,6 +15,9 @@ from pathlib import Path
 
 import pytest
 
+# every test computes the consistent weights it checks, and none writes to ~/.cache
+os.environ.setdefault("PERITHERM_CACHE", "off")
+
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"
 

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 /// path from there).
 fn rerun(args: &[String], out: &Path) -> Result<(), String> {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_peritherm"))
+        .env("PERITHERM_CACHE", "off")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(args)
         .arg("--out")

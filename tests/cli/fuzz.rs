@@ -81,6 +81,7 @@ fn validate(text: &str, path: &Path) -> Result<(), String> {
     let case = Case::parse(text, path).map_err(|e| e.to_string())?;
     let options = Options {
         max_memory: Some(MAX_MEMORY),
+        cache: None,
     };
     let model = build(&case, &options).map_err(|e| e.to_string())?;
     plan(&case, &model).map(|_| ()).map_err(|e| e.to_string())

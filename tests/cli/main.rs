@@ -11,8 +11,10 @@ mod common {
     pub mod case;
     pub mod cli;
     pub mod hostile;
+    pub mod runs;
 }
 
+mod cache;
 mod commands;
 mod figures;
 mod fuzz;

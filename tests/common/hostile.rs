@@ -64,6 +64,7 @@ pub fn peritherm(args: &[&str]) -> Outcome {
     } else {
         cmd.arg(format!("ulimit -v {ADDRESS_KIB}; exec \"$0\" \"$@\""));
     }
+    cmd.env(super::cli::CACHE_VAR, "off");
     let o = cmd.arg(super::cli::EXE).args(args).output().unwrap();
     let max_kib = std::fs::read_to_string(report.path())
         .ok()

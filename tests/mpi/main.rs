@@ -27,6 +27,7 @@ use std::process::{Command, Output};
 /// Cholesky factorisations are not the same bits on every thread count).
 fn mpiexec(ranks: usize, args: &[&str]) -> Output {
     Command::new("mpiexec")
+        .env(common::cli::CACHE_VAR, "off")
         .args(open_mpi_flags())
         .args(["-n", &ranks.to_string(), EXE, "--threads", "1"])
         .args(args)

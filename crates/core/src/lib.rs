@@ -25,6 +25,7 @@ pub mod model;
 pub mod neighbors;
 pub mod operator;
 pub mod partition;
+pub mod progress;
 pub mod solve;
 pub mod spatial;
 pub mod stencil;

@@ -15,7 +15,8 @@ use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::partition::Partition;
 use crate::symmetry::Symmetry;
-use crate::weights::{correct, Consistency, Order};
+use crate::weights::store::Store;
+use crate::weights::{correct_reusing, Consistency, Order};
 use std::ops::Range;
 
 /// Initial temperature field.
@@ -356,6 +357,7 @@ impl Bonds {
         layered: &[bool],
         bond_conductivity: &[f64],
         rows: Range<usize>,
+        store: Option<&dyn Store>,
     ) -> Bonds {
         let mut weights = directed_weights(
             cloud,
@@ -383,12 +385,13 @@ impl Bonds {
         let (correction, consistent) =
             if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
                 let sel = complete_horizons(cloud, horizons, layered, mu);
-                let (c, met) = correct(
+                let (c, met) = correct_reusing(
                     &mut conductance,
                     cloud,
                     &sel,
                     bond_conductivity,
                     spec.consistency,
+                    store,
                 );
                 (Some(c), met)
             } else {
@@ -498,10 +501,16 @@ impl Model {
 
     /// Builds cloud, bonds, conductance and boundary from a spec.
     pub fn build(spec: &ModelSpec) -> Result<Model> {
+        Self::build_with(spec, None)
+    }
+
+    /// [`Model::build`], reusing consistent weights kept in `store` (and keeping new ones
+    /// there): the model is the same bits with or without it.
+    pub fn build_with(spec: &ModelSpec, store: Option<&dyn Store>) -> Result<Model> {
         let (phase, layered, cloud) = prelude(spec)?;
         let horizons = Horizons::build(&cloud, &spec.kernel);
         let rows = 0..cloud.n_body;
-        Self::finish(spec, cloud, horizons, phase, &layered, rows)
+        Self::finish(spec, cloud, horizons, phase, &layered, rows, store)
     }
 
     /// Whether a spec can be built one rank's share at a time ([`Model::build_share`]): every
@@ -528,7 +537,7 @@ impl Model {
         let partition = Partition::by_estimate(&cloud, ranks);
         let rows = partition.range(rank.min(partition.ranks() - 1));
         let horizons = Horizons::build_rows(&cloud, &spec.kernel, rows.clone());
-        let model = Self::finish(spec, cloud, horizons, phase, &layered, rows)?;
+        let model = Self::finish(spec, cloud, horizons, phase, &layered, rows, None)?;
         Ok((model, partition))
     }
 
@@ -560,6 +569,7 @@ impl Model {
         phase: bool,
         layered: &[bool],
         rows: Range<usize>,
+        store: Option<&dyn Store>,
     ) -> Result<Model> {
         let (conductivity, capacity) = heat_of(spec, &cloud);
         // with phase change, K for unit conductivity; λ̄_ij(t) scales it as the state evolves
@@ -575,6 +585,7 @@ impl Model {
             layered,
             &bond_conductivity,
             rows.clone(),
+            store,
         );
         let micro = bonds.micro(spec, &cloud, &horizons);
         let micro = micro.as_deref().map(|m| (&horizons, m));

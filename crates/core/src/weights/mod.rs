@@ -46,10 +46,12 @@
 mod additive;
 mod coarse;
 mod direct;
+pub mod store;
 
 use crate::cloud::Cloud;
 use crate::math::{Real, Vector};
 use crate::operator::Conductance;
+use crate::progress;
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
@@ -94,6 +96,10 @@ pub struct Consistency {
     pub min_ratio: Real,
     /// Largest ratio K'_ij / K_ij over all stored pairs.
     pub max_ratio: Real,
+    /// Whether the weights were loaded from a store of earlier solves ([`store`]) instead
+    /// of computed (the other fields are those of the solve that computed them).
+    #[serde(default)]
+    pub reused: bool,
 }
 
 /// faer's parallelism in the factorisations of the correction: sequential, because faer's
@@ -574,6 +580,11 @@ fn newton(p: &Problem, lambda: &mut [Mom], vals: &mut [Real]) -> (usize, usize) 
         if worst <= TOLERANCE || stalled(&history) {
             break;
         }
+        progress::report(progress::Event::Newton {
+            step: newton + 1,
+            residual: worst,
+            iterations: cg,
+        });
         let rhs: Vec<Mom> = res.iter().map(|r| -r).collect();
         let forcing = forcing(worst);
         // a factor of H at earlier weights preconditions CG until CG needs many iterations
@@ -659,6 +670,39 @@ pub fn correct(
     correct_within(k, cloud, sel, conductivity, order, room)
 }
 
+/// [`correct`], first looking in `store` for the weights of the same problem ([`store::key`])
+/// and keeping them there once solved; the weights are the same bits either way.
+pub fn correct_reusing(
+    k: &mut Conductance,
+    cloud: &Cloud,
+    sel: &[bool],
+    conductivity: &[Real],
+    order: Order,
+    store: Option<&dyn store::Store>,
+) -> (Consistency, Vec<bool>) {
+    let Some(store) = store else {
+        return correct(k, cloud, sel, conductivity, order);
+    };
+    let key = store::key(k, cloud, sel, conductivity, order);
+    if let Some(found) = store.load(&key, k.vals.len(), k.n_rows()) {
+        progress::report(progress::Event::WeightsLoaded);
+        store_vals(k, found.vals);
+        let summary = Consistency {
+            reused: true,
+            ..found.summary
+        };
+        return (summary, found.met);
+    }
+    let (summary, met) = correct(k, cloud, sel, conductivity, order);
+    let solved = store::Solved {
+        vals: k.vals.clone(),
+        met: met.clone(),
+        summary,
+    };
+    store.save(&key, &solved);
+    (summary, met)
+}
+
 /// [`correct`] with `factor_room` bytes for a direct factorisation of the Newton matrix
 /// (None: no limit); a factor that would not fit is left to CG, which reaches the same
 /// weights more slowly.
@@ -685,6 +729,10 @@ pub fn correct_within(
         return (out, p.sel);
     }
     let full = p.sel.clone();
+    progress::report(progress::Event::WeightsStart {
+        nodes: full.iter().filter(|&&s| s).count(),
+        pairs: k.vals.len(),
+    });
     let seeds = p.missing(&p.k0, &full);
     let mut hops = FIRST_HOPS;
     let (vals, left_out) = loop {
@@ -705,7 +753,7 @@ pub fn correct_within(
     }
     summarise(&p, &vals, &left_out, &mut out);
     let sel = p.sel;
-    store(k, vals);
+    store_vals(k, vals);
     (out, sel)
 }
 
@@ -774,7 +822,7 @@ fn solve_selection(p: &mut Problem, order: Order, out: &mut Consistency) -> (Vec
 }
 
 /// Stores the pair conductances `vals` in `k` with their row sums.
-fn store(k: &mut Conductance, vals: Vec<Real>) {
+fn store_vals(k: &mut Conductance, vals: Vec<Real>) {
     k.vals = vals;
     for i in 0..k.n_rows() {
         k.diag[i] = k.vals[k.offsets[i]..k.offsets[i + 1]].iter().sum();
