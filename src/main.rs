@@ -699,7 +699,24 @@ fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyho
     use peritherm::solve::Integrator;
     let case = Case::load(path)?;
     say!("{}: {}", case.path.display(), case.budget.line());
-    let model = peritherm::prepare::build(&case, options)?;
+    let started = std::time::Instant::now();
+    let setup = SetupBar::new(false);
+    let model = peritherm::prepare::build(&case, options);
+    setup.stepping(&ProgressBar::hidden());
+    let model = model?;
+    if let Some(c) = &model.correction {
+        say!(
+            "{}: consistent weights at {} nodes {} in {:.2} s",
+            case.path.display(),
+            c.corrected,
+            if c.reused {
+                "loaded from the weights cache"
+            } else {
+                "solved"
+            },
+            started.elapsed().as_secs_f64()
+        );
+    }
     let plan = peritherm::prepare::plan(&case, &model)?;
     let sizes = format!(
         "{}: {} body nodes, {} fictitious, {} directed bonds",

@@ -218,3 +218,23 @@ fn a_damaged_cache_file_is_recomputed_not_trusted() {
         );
     }
 }
+
+/// `check` solves the weights once and says so; the next `check` (or run) loads them.
+#[test]
+fn check_keeps_the_weights_for_the_next_command() {
+    let s = Setting::new();
+    let check = || {
+        let o = command()
+            .arg("--cache")
+            .arg(s.cache())
+            .arg("check")
+            .arg(s.dir.path().join("case.toml"))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    assert!(check().contains("consistent weights at 1868 nodes solved"));
+    assert!(check().contains("consistent weights at 1868 nodes loaded from the weights cache"));
+    assert!(reused(&s.run("after", true, &[])), "the run after check");
+}
