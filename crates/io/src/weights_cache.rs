@@ -10,7 +10,7 @@
 //! none; the cache is kept under its size by deleting the least recently used files.
 
 use peritherm_core::math::Real;
-use peritherm_core::weights::store::{Key, Solved, Store};
+use peritherm_core::weights::store::{Key, Solved, SolvedRef, Store};
 use peritherm_core::weights::Consistency;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -119,7 +119,7 @@ impl WeightsCache {
     }
 
     /// Writes `solved` under `key` through a partial file and a rename.
-    fn write(&self, key: &Key, solved: &Solved) -> std::io::Result<()> {
+    fn write(&self, key: &Key, solved: SolvedRef) -> std::io::Result<()> {
         std::fs::create_dir_all(&self.dir)?;
         let path = self.path(key);
         let tmp = self
@@ -174,7 +174,7 @@ impl Store for WeightsCache {
         self.read(key, entries, nodes)
     }
 
-    fn save(&self, key: &Key, solved: &Solved) {
+    fn save(&self, key: &Key, solved: SolvedRef) {
         if self.read_only || file_bytes(solved) > self.max_bytes {
             return;
         }
@@ -194,15 +194,15 @@ fn default_dir() -> Option<PathBuf> {
 }
 
 /// The size of the file of `solved`, bytes.
-fn file_bytes(solved: &Solved) -> u64 {
-    let summary = serde_json::to_vec(&solved.summary).map_or(0, |s| s.len());
+fn file_bytes(solved: SolvedRef) -> u64 {
+    let summary = serde_json::to_vec(solved.summary).map_or(0, |s| s.len());
     (HEADER + summary + 8 * solved.vals.len() + solved.met.len()) as u64
 }
 
 /// Writes the header and payload of `solved` to `path`.
-fn write_file(path: &Path, key: &Key, solved: &Solved) -> std::io::Result<()> {
-    let summary = serde_json::to_vec(&solved.summary).map_err(std::io::Error::other)?;
-    let hash = payload_hash(&summary, &solved.vals, &solved.met);
+fn write_file(path: &Path, key: &Key, solved: SolvedRef) -> std::io::Result<()> {
+    let summary = serde_json::to_vec(solved.summary).map_err(std::io::Error::other)?;
+    let hash = payload_hash(&summary, solved.vals, solved.met);
     let mut w = BufWriter::with_capacity(CHUNK, File::create(path)?);
     w.write_all(MAGIC)?;
     w.write_all(&key.0)?;
@@ -211,7 +211,7 @@ fn write_file(path: &Path, key: &Key, solved: &Solved) -> std::io::Result<()> {
     }
     w.write_all(&hash)?;
     w.write_all(&summary)?;
-    for v in &solved.vals {
+    for v in solved.vals {
         w.write_all(&v.to_le_bytes())?;
     }
     let flags: Vec<u8> = solved.met.iter().map(|&m| m as u8).collect();
@@ -300,7 +300,7 @@ mod tests {
     fn a_saved_entry_loads_back_bit_for_bit() {
         let c = cache("round");
         let key = Key([7; 32]);
-        c.save(&key, &solved());
+        c.save(&key, solved().view());
         assert_eq!(c.load(&key, 1000, 40), Some(solved()));
         assert_eq!(c.load(&Key([8; 32]), 1000, 40), None, "another key");
         assert_eq!(c.load(&key, 999, 40), None, "other counts");
@@ -311,7 +311,7 @@ mod tests {
     fn truncated_or_flipped_files_are_refused_and_removed() {
         let c = cache("corrupt");
         let key = Key([1; 32]);
-        c.save(&key, &solved());
+        c.save(&key, solved().view());
         let path = c.path(&key);
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
@@ -327,25 +327,25 @@ mod tests {
     #[test]
     fn the_least_recently_used_files_go_first() {
         let mut c = cache("lru");
-        let one = file_bytes(&solved());
+        let one = file_bytes(solved().view());
         c.max_bytes = 2 * one;
         let keys = [Key([1; 32]), Key([2; 32]), Key([3; 32])];
-        c.save(&keys[0], &solved());
-        c.save(&keys[1], &solved());
+        c.save(&keys[0], solved().view());
+        c.save(&keys[1], solved().view());
         let past = SystemTime::now() - Duration::from_secs(60);
         for (k, age) in keys[..2].iter().zip([1, 2]) {
             let f = File::options().append(true).open(c.path(k)).unwrap();
             f.set_modified(past - Duration::from_secs(age)).unwrap();
         }
         assert!(c.load(&keys[1], 1000, 40).is_some(), "used: now the newest");
-        c.save(&keys[2], &solved());
+        c.save(&keys[2], solved().view());
         assert!(
             !c.path(&keys[0]).exists(),
             "the least recently used is gone"
         );
         assert!(c.path(&keys[1]).exists() && c.path(&keys[2]).exists());
         c.max_bytes = one - 1;
-        c.save(&Key([4; 32]), &solved());
+        c.save(&Key([4; 32]), solved().view());
         assert!(
             !c.path(&Key([4; 32])).exists(),
             "larger than the cache: not kept"

@@ -694,12 +694,12 @@ pub fn correct_reusing(
         return (summary, found.met);
     }
     let (summary, met) = correct(k, cloud, sel, conductivity, order);
-    let solved = store::Solved {
-        vals: k.vals.clone(),
-        met: met.clone(),
-        summary,
+    let solved = store::SolvedRef {
+        vals: &k.vals,
+        met: &met,
+        summary: &summary,
     };
-    store.save(&key, &solved);
+    store.save(&key, solved);
     (summary, met)
 }
 

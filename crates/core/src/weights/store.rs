@@ -39,6 +39,28 @@ pub struct Solved {
     pub summary: Consistency,
 }
 
+/// A solved correction as borrowed slices (what [`Store::save`] writes, without a copy).
+#[derive(Debug, Clone, Copy)]
+pub struct SolvedRef<'a> {
+    /// K' per CSR entry of K, W/K.
+    pub vals: &'a [Real],
+    /// Body nodes whose moments the correction met.
+    pub met: &'a [bool],
+    /// The summary of the correction as computed.
+    pub summary: &'a Consistency,
+}
+
+impl Solved {
+    /// The correction as borrowed slices.
+    pub fn view(&self) -> SolvedRef<'_> {
+        SolvedRef {
+            vals: &self.vals,
+            met: &self.met,
+            summary: &self.summary,
+        }
+    }
+}
+
 /// Where solved corrections are kept between runs.
 pub trait Store: Sync {
     /// The correction stored under `key`, if there is an intact one with `entries` values and
@@ -46,7 +68,7 @@ pub trait Store: Sync {
     fn load(&self, key: &Key, entries: usize, nodes: usize) -> Option<Solved>;
     /// Keeps `solved` under `key` (a store that cannot write says nothing: reuse is an
     /// optimisation, never a condition of a run).
-    fn save(&self, key: &Key, solved: &Solved);
+    fn save(&self, key: &Key, solved: SolvedRef);
 }
 
 /// Feeds a slice of plain numbers to the hasher as little-endian bytes, with its length.
