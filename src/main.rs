@@ -282,7 +282,7 @@ fn real_main(cli: Cli) -> anyhow::Result<()> {
             .map_err(anyhow::Error::msg)?;
     let options = peritherm::prepare::Options {
         max_memory: cli.max_memory,
-        cache: cache.map(std::sync::Arc::new),
+        cache,
     };
     if let Some(n) = cli.threads {
         rayon::ThreadPoolBuilder::new()
@@ -449,17 +449,15 @@ fn run(
         setup.stepping(&bar);
         bar.set_length(total);
         bar.set_position(done);
-    });
-    setup.stepping(&bar);
-    let summary = summary?;
+    })?;
     bar.finish_and_clear();
     print_run(&case, &summary, out);
     Ok(())
 }
 
 /// The set-up's progress on a terminal (the consistent weights' Newton steps and residual),
-/// until the first step; then the step bar's clock starts, so its elapsed time and ETA count
-/// the stepping only.
+/// until the first step ([`SetupBar::stepping`]) or until it is dropped (a failed set-up,
+/// `check`).
 struct SetupBar {
     bar: ProgressBar,
     done: std::cell::Cell<bool>,
@@ -503,13 +501,25 @@ impl SetupBar {
         }
     }
 
-    /// Ends the set-up display (once) and starts the step bar's clock.
+    /// Ends the set-up display and, the first time, starts the step bar's clock, so that its
+    /// elapsed time and ETA count the stepping only.
     fn stepping(&self, steps: &ProgressBar) {
         if !self.done.replace(true) {
-            peritherm::progress::set_sink(None);
-            self.bar.finish_and_clear();
+            self.finish();
             steps.reset();
         }
+    }
+
+    /// Stops reporting and clears the display.
+    fn finish(&self) {
+        peritherm::progress::set_sink(None);
+        self.bar.finish_and_clear();
+    }
+}
+
+impl Drop for SetupBar {
+    fn drop(&mut self) {
+        self.finish();
     }
 }
 
@@ -540,9 +550,7 @@ fn run_mpi(
         setup.stepping(&bar);
         bar.set_length(total);
         bar.set_position(done);
-    });
-    setup.stepping(&bar);
-    let summary = summary?;
+    })?;
     bar.finish_and_clear();
     if let Some(summary) = summary {
         print_run(&case, &summary, out);
@@ -701,9 +709,8 @@ fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyho
     say!("{}: {}", case.path.display(), case.budget.line());
     let started = std::time::Instant::now();
     let setup = SetupBar::new(false);
-    let model = peritherm::prepare::build(&case, options);
-    setup.stepping(&ProgressBar::hidden());
-    let model = model?;
+    let model = peritherm::prepare::build(&case, options)?;
+    drop(setup);
     if let Some(c) = &model.correction {
         say!(
             "{}: consistent weights at {} nodes {} in {:.2} s",

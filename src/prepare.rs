@@ -13,7 +13,6 @@ use crate::solve::implicit::{symmetric_over, Adaptive};
 use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
 use crate::weights::store::Store;
 use crate::weights_cache::WeightsCache;
-use std::sync::Arc;
 
 /// Settings of a run that are not part of the case.
 #[derive(Debug, Clone, Default)]
@@ -21,13 +20,13 @@ pub struct Options {
     /// Memory a run may plan to use, bytes (None: a fraction of the machine's available).
     pub max_memory: Option<f64>,
     /// Where consistent weights are kept between runs (None: always computed).
-    pub cache: Option<Arc<WeightsCache>>,
+    pub cache: Option<WeightsCache>,
 }
 
 impl Options {
     /// The weights store of a process that keeps new weights (`writes`) or only reads them.
     fn store(&self, writes: bool) -> Option<WeightsCache> {
-        let cache = self.cache.as_deref()?;
+        let cache = self.cache.as_ref()?;
         Some(if writes {
             cache.clone()
         } else {

@@ -282,16 +282,9 @@ fn execute(
             (_, w) => w,
         }
     };
+    let mut on_step = step_progress(case, &schedule, total, &mut progress);
     // the stepping starts: a progress display's clock starts here (set-up and reference excluded)
-    progress(
-        0,
-        if schedule.adaptive.is_some() {
-            0
-        } else {
-            total
-        },
-    );
-    let on_step = step_progress(case, &schedule, total, &mut progress);
+    on_step(0, 0.0);
     let stats = integrate(
         &mut engine,
         &schedule,

@@ -332,10 +332,7 @@ fn run_options(max_memory: Option<f64>) -> peritherm::Result<peritherm::prepare:
                 message,
             }
         })?;
-    Ok(peritherm::prepare::Options {
-        max_memory,
-        cache: cache.map(Arc::new),
-    })
+    Ok(peritherm::prepare::Options { max_memory, cache })
 }
 
 /// A built model with its temperature, time and integrator.
