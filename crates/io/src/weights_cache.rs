@@ -13,7 +13,7 @@ use peritherm_core::math::Real;
 use peritherm_core::weights::store::{Key, Solved, SolvedRef, Store};
 use peritherm_core::weights::Consistency;
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
@@ -118,14 +118,15 @@ impl WeightsCache {
         }
     }
 
-    /// Writes `solved` under `key` through a partial file and a rename.
-    fn write(&self, key: &Key, solved: SolvedRef) -> std::io::Result<()> {
+    /// Writes `solved` (its summary serialised as `summary`) under `key` through a partial file
+    /// and a rename.
+    fn write(&self, key: &Key, summary: &[u8], solved: SolvedRef) -> std::io::Result<()> {
         std::fs::create_dir_all(&self.dir)?;
         let path = self.path(key);
         let tmp = self
             .dir
             .join(format!(".{}.{}.partial", key.hex(), std::process::id()));
-        let written = write_file(&tmp, key, solved);
+        let written = write_file(&tmp, key, summary, solved);
         if written.is_err() {
             let _ = std::fs::remove_file(&tmp);
             return written;
@@ -175,10 +176,13 @@ impl Store for WeightsCache {
     }
 
     fn save(&self, key: &Key, solved: SolvedRef) {
-        if self.read_only || file_bytes(solved) > self.max_bytes {
+        let Ok(summary) = serde_json::to_vec(solved.summary) else {
+            return;
+        };
+        if self.read_only || file_bytes(&summary, solved) > self.max_bytes {
             return;
         }
-        if self.write(key, solved).is_ok() {
+        if self.write(key, &summary, solved).is_ok() {
             self.evict();
         }
     }
@@ -193,47 +197,41 @@ fn default_dir() -> Option<PathBuf> {
     Some(base.join("peritherm").join("weights"))
 }
 
-/// The size of the file of `solved`, bytes.
-fn file_bytes(solved: SolvedRef) -> u64 {
-    let summary = serde_json::to_vec(solved.summary).map_or(0, |s| s.len());
-    (HEADER + summary + 8 * solved.vals.len() + solved.met.len()) as u64
+/// The size of the file of `solved` with its summary serialised as `summary`, bytes.
+fn file_bytes(summary: &[u8], solved: SolvedRef) -> u64 {
+    (HEADER + summary.len() + 8 * solved.vals.len() + solved.met.len()) as u64
 }
 
-/// Writes the header and payload of `solved` to `path`.
-fn write_file(path: &Path, key: &Key, solved: SolvedRef) -> std::io::Result<()> {
-    let summary = serde_json::to_vec(solved.summary).map_err(std::io::Error::other)?;
-    let hash = payload_hash(&summary, solved.vals, solved.met);
+/// Writes the header and payload of `solved` (its summary serialised as `summary`) to `path`
+/// in one pass: the payload's hash, known at the end, is then written into the header.
+fn write_file(path: &Path, key: &Key, summary: &[u8], solved: SolvedRef) -> std::io::Result<()> {
     let mut w = BufWriter::with_capacity(CHUNK, File::create(path)?);
     w.write_all(MAGIC)?;
     w.write_all(&key.0)?;
     for n in [solved.vals.len(), solved.met.len(), summary.len()] {
         w.write_all(&(n as u64).to_le_bytes())?;
     }
-    w.write_all(&hash)?;
-    w.write_all(&summary)?;
-    for v in solved.vals {
-        w.write_all(&v.to_le_bytes())?;
-    }
-    let flags: Vec<u8> = solved.met.iter().map(|&m| m as u8).collect();
-    w.write_all(&flags)?;
-    w.into_inner().map_err(|e| e.into_error())?.sync_all()
-}
-
-/// The BLAKE3 hash of a payload, fed as it is stored.
-fn payload_hash(summary: &[u8], vals: &[Real], met: &[bool]) -> [u8; 32] {
+    w.write_all(&[0u8; 32])?;
     let mut h = blake3::Hasher::new();
-    h.update(summary);
+    let mut put = |bytes: &[u8]| {
+        h.update(bytes);
+        w.write_all(bytes)
+    };
+    put(summary)?;
     let mut buf = Vec::with_capacity(CHUNK);
-    for chunk in vals.chunks(CHUNK / 8) {
+    for chunk in solved.vals.chunks(CHUNK / 8) {
         buf.clear();
         chunk
             .iter()
             .for_each(|v| buf.extend_from_slice(&v.to_le_bytes()));
-        h.update(&buf);
+        put(&buf)?;
     }
-    let flags: Vec<u8> = met.iter().map(|&m| m as u8).collect();
-    h.update(&flags);
-    *h.finalize().as_bytes()
+    let flags: Vec<u8> = solved.met.iter().map(|&m| m as u8).collect();
+    put(&flags)?;
+    let mut file = w.into_inner().map_err(|e| e.into_error())?;
+    file.seek(SeekFrom::Start((HEADER - 32) as u64))?;
+    file.write_all(h.finalize().as_bytes())?;
+    file.sync_all()
 }
 
 /// Reads a cache file, checking everything; None at the first thing that is not right.
@@ -252,13 +250,16 @@ fn read_checked(file: File, key: &Key, entries: usize, nodes: usize) -> Option<S
     if !sizes_match {
         return None;
     }
+    let mut h = blake3::Hasher::new();
     let mut summary = vec![0u8; summary_len as usize];
     r.read_exact(&mut summary).ok()?;
+    h.update(&summary);
     let mut vals = Vec::with_capacity(entries);
     let mut buf = vec![0u8; CHUNK];
     while vals.len() < entries {
         let n = (8 * (entries - vals.len())).min(CHUNK);
         r.read_exact(&mut buf[..n]).ok()?;
+        h.update(&buf[..n]);
         vals.extend(
             buf[..n]
                 .chunks_exact(8)
@@ -267,9 +268,10 @@ fn read_checked(file: File, key: &Key, entries: usize, nodes: usize) -> Option<S
     }
     let mut flags = vec![0u8; nodes];
     r.read_exact(&mut flags).ok()?;
+    h.update(&flags);
     let met: Vec<bool> = flags.iter().map(|&f| f == 1).collect();
     let intact = flags.iter().all(|&f| f <= 1)
-        && payload_hash(&summary, &vals, &met) == header[HEADER - 32..]
+        && h.finalize().as_bytes()[..] == header[HEADER - 32..]
         && vals.iter().all(|v| v.is_finite() && *v >= 0.0);
     let summary: Consistency = serde_json::from_slice(&summary).ok()?;
     intact.then_some(Solved { vals, met, summary })
@@ -327,7 +329,8 @@ mod tests {
     #[test]
     fn the_least_recently_used_files_go_first() {
         let mut c = cache("lru");
-        let one = file_bytes(solved().view());
+        let summary = serde_json::to_vec(&solved().summary).unwrap();
+        let one = file_bytes(&summary, solved().view());
         c.max_bytes = 2 * one;
         let keys = [Key([1; 32]), Key([2; 32]), Key([3; 32])];
         c.save(&keys[0], solved().view());

@@ -110,11 +110,13 @@ pub fn key(
         .unwrap_or(0)
         .max(n);
     let reach = reach.min(cloud.pos.len());
-    let coords: Vec<Real> = cloud.pos[..reach]
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
-        .collect();
-    feed(&mut h, &coords, Real::to_le_bytes);
+    feed(&mut h, &cloud.pos[..reach], |p| {
+        let mut b = [0u8; 24];
+        for (c, x) in b.chunks_exact_mut(8).zip([p.x, p.y, p.z]) {
+            c.copy_from_slice(&x.to_le_bytes());
+        }
+        b
+    });
     feed(
         &mut h,
         &cloud.horizon[..reach.min(cloud.horizon.len())],
