@@ -2,7 +2,7 @@
 //! allocated, the model, the semantic checks a valid-looking case can still fail, and the
 //! plan of the time loop (step, step count, steppers). `check` stops here; `run` goes on.
 
-use crate::bc::FaceBc;
+use crate::bc::{FaceBc, NonFinite};
 use crate::case::Case;
 use crate::cloud::FACE_NAMES;
 use crate::error::{Error, Result};
@@ -80,9 +80,9 @@ fn build_keeping(case: &Case, options: &Options, writes: bool) -> Result<Model> 
         .map_err(|message| case.error(&case.budget.key, message))?;
     let store = options.store(writes);
     let store = store.as_ref().map(|s| s as &dyn Store);
-    let model = Model::build_with(&case.spec, store).map_err(|e| keyed(case, e))?;
-    semantic(case, &model).map_err(|e| keyed(case, e))?;
-    Ok(model)
+    // the semantic checks run before the consistent weights are solved
+    Model::build_checked(&case.spec, store, |model| semantic(case, model))
+        .map_err(|e| keyed(case, e))
 }
 
 /// What a model built from valid keys can still get wrong: regions without nodes, nodes
@@ -92,7 +92,133 @@ pub fn semantic(case: &Case, model: &Model) -> Result<()> {
     regions_have_nodes(case, model)?;
     let (count, first) = lonely(model);
     no_lonely(model, count, first)?;
-    duplicates(case, model)
+    duplicates(case, model)?;
+    match first_non_finite(case, model) {
+        Some(bad) => Err(bad.error(case)),
+        None => Ok(()),
+    }
+}
+
+/// Where an expression of the case is not finite: the time's index among [`check_times`], the
+/// key's index among [`expression_keys`], and the place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct BadExpression {
+    time: usize,
+    key: usize,
+    found: NonFinite,
+}
+
+/// The times at which the boundary values and the source are checked before a run: t = 0 and
+/// every output time, s.
+fn check_times(case: &Case) -> Vec<f64> {
+    let mut times = vec![0.0];
+    times.extend(case.outputs.iter().copied());
+    if case.outputs.is_empty() {
+        times.push(case.end);
+    }
+    times
+}
+
+/// The key of every boundary set's expression (`boundary.NAME.value` or `.ambient`; `-` for
+/// a set without one), then `source.value`.
+fn expression_keys(case: &Case) -> Vec<String> {
+    let names: Vec<String> = match &case.spec.geometry {
+        Geometry::Box(_) => FACE_NAMES.iter().map(|s| s.to_string()).collect(),
+        Geometry::Mesh(g) => g.set_names(),
+    };
+    let mut keys: Vec<String> = case
+        .spec
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            let name = names.get(f).map_or("-", |n| n.as_str());
+            match face {
+                FaceBc::Convection { .. } | FaceBc::LayerConvection { .. } => {
+                    format!("boundary.{name}.ambient")
+                }
+                _ => format!("boundary.{name}.value"),
+            }
+        })
+        .collect();
+    keys.push("source.value".into());
+    keys
+}
+
+impl BadExpression {
+    /// The refusal, naming the key, the place and the time.
+    fn error(&self, case: &Case) -> Error {
+        let keys = expression_keys(case);
+        let key = match self.found.face {
+            Some(f) => keys[f].clone(),
+            None => keys[keys.len() - 1].clone(),
+        };
+        let t = check_times(case)[self.time];
+        let p = self.found.at;
+        case.error(
+            key,
+            format!(
+                "not finite ({}) at ({}, {}, {}) m, t = {t} s",
+                self.found.value, p.x, p.y, p.z
+            ),
+        )
+    }
+}
+
+/// The first time, and there the first boundary set (then the source), at which an
+/// expression is not finite where the run evaluates it.
+fn first_non_finite(case: &Case, model: &Model) -> Option<BadExpression> {
+    let n_keys = case.spec.faces.len();
+    check_times(case).iter().enumerate().find_map(|(time, &t)| {
+        let found = model.boundary.non_finite(&model.cloud, t)?;
+        let key = found.face.unwrap_or(n_keys);
+        Some(BadExpression { time, key, found })
+    })
+}
+
+/// [`first_non_finite`] over the shares of `link`'s ranks: every rank gets the same answer
+/// (the earliest time, then the first key, then the least position).
+fn first_non_finite_over(
+    case: &Case,
+    model: &Model,
+    link: &dyn Collective,
+) -> Option<BadExpression> {
+    let mine = first_non_finite(case, model);
+    let code = |b: &BadExpression| (b.time * (case.spec.faces.len() + 1) + b.key) as f64;
+    let least = link.reduce(mine.as_ref().map_or(f64::INFINITY, code), Reduce::Min);
+    if !least.is_finite() {
+        return None;
+    }
+    let mut ours = mine.filter(|b| code(b) == least);
+    let mut found = NonFinite {
+        face: None,
+        at: crate::math::Point::origin(),
+        value: f64::NAN,
+    };
+    for axis in 0..3 {
+        let v = ours.as_ref().map_or(f64::INFINITY, |b| b.found.at[axis]);
+        found.at[axis] = link.reduce(v, Reduce::Min);
+        ours = ours.filter(|b| b.found.at[axis] == found.at[axis]);
+    }
+    // NaN, +inf, -inf as 0, 1, 2
+    let kind = |v: f64| {
+        if v.is_nan() {
+            0.0
+        } else if v > 0.0 {
+            1.0
+        } else {
+            2.0
+        }
+    };
+    let k = link.reduce(
+        ours.as_ref().map_or(3.0, |b| kind(b.found.value)),
+        Reduce::Min,
+    );
+    found.value = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][k as usize];
+    let n_keys = case.spec.faces.len() + 1;
+    let (time, key) = (least as usize / n_keys, least as usize % n_keys);
+    found.face = (key < case.spec.faces.len()).then_some(key);
+    Some(BadExpression { time, key, found })
 }
 
 /// Refuses a region without nodes (no element of the mesh's group, or no cell).
@@ -179,6 +305,9 @@ pub fn build_rank(
     let first = link.reduce(first.map_or(f64::INFINITY, |i| i as f64), Reduce::Min);
     let first = first.is_finite().then_some(first as usize);
     semantic_share(case, &model, count, first).map_err(|e| keyed(case, e))?;
+    if let Some(bad) = first_non_finite_over(case, &model, link) {
+        return Err(bad.error(case));
+    }
     let lambda = link.reduce(model.lambda_max(), Reduce::Max);
     model.set_lambda_max(lambda);
     let implicit = case.integrator.is_implicit();
@@ -252,32 +381,34 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
     let fixed = case.integrator != Integrator::Steady && adaptive.is_none();
     let total = if fixed {
         let end = case.outputs.last().copied().unwrap_or(case.end);
-        let steps = end / dt;
-        if !crate::limits::within(steps, MAX_STEPS) {
-            let (key, why) = match case.dt {
-                Some(_) => ("time.dt", format!("time.dt = {dt:e} s")),
-                None => (
-                    "time.end",
-                    format!(
-                        "the stable step {dt:e} s of {} (set by the materials and the spacing)",
-                        case.integrator.name()
-                    ),
-                ),
-            };
-            return Err(case.error(
-                key,
-                format!(
-                    "{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"
-                ),
-            ));
-        }
-        count_steps(0.0, &case.times(), dt)
+        let why = match case.dt {
+            Some(_) => format!("time.dt = {dt:e} s"),
+            None => format!(
+                "the stable step {dt:e} s of {} (set by the materials and the spacing)",
+                case.integrator.name()
+            ),
+        };
+        let key = if case.dt.is_some() {
+            "time.dt"
+        } else {
+            "time.end"
+        };
+        within_budget(case, end / dt, end, key, &why)?;
+        let total = count_steps(0.0, &case.times(), dt);
+        within_budget(case, total as f64, end, key, &why)?;
+        total
     } else {
         0
     };
+    if let Some(a) = &adaptive {
+        adaptive_within_budget(case, a)?;
+    }
     // the stepper's set-up (implicit: elimination, symbolic factorisation) is part of the plan
     let engine =
         Engine::new(model, case.integrator, adaptive.is_some()).map_err(|e| keyed(case, e))?;
+    if let (Engine::Implicit(implicit), Integrator::Steady) = (&engine, case.integrator) {
+        implicit.level_fixed().map_err(|e| keyed(case, e))?;
+    }
     Ok(Plan {
         dt,
         adaptive,
@@ -285,6 +416,34 @@ pub fn plan<'a>(case: &Case, model: &'a Model) -> Result<Plan<'a>> {
         steady: case.integrator == Integrator::Steady,
         engine,
     })
+}
+
+/// Refuses `steps` steps to reach `end` (s) with `why` beyond [`MAX_STEPS`], keyed at `key`.
+fn within_budget(case: &Case, steps: f64, end: f64, key: &str, why: &str) -> Result<()> {
+    if crate::limits::within(steps, MAX_STEPS) {
+        return Ok(());
+    }
+    Err(case.error(
+        key,
+        format!("{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"),
+    ))
+}
+
+/// Refuses an adaptive run whose largest step (`time.dt_max`, else a tenth of the span) needs
+/// more than [`MAX_STEPS`] steps to the last output; a run that falls below it is stopped at
+/// that many steps ([`crate::solve::implicit`]).
+fn adaptive_within_budget(case: &Case, a: &Adaptive) -> Result<()> {
+    let end = case.outputs.last().copied().unwrap_or(case.end);
+    match a.max {
+        Some(top) => within_budget(
+            case,
+            end / top,
+            end,
+            "time.dt_max",
+            &format!("steps of at most time.dt_max = {top:e} s"),
+        ),
+        None => Ok(()),
+    }
 }
 
 /// The key that most likely made the state non-finite at node `node` by time `t`: a source or

@@ -105,6 +105,71 @@ fn every_hostile_case_is_refused_alike_by_check_and_run() {
     }
 }
 
+/// Issue 36's examples, which `check` passed and `run` refused (the expressions only after
+/// stepping to the first output): (what, case text, key).
+fn check_passed_run_refused() -> Vec<(&'static str, String, &'static str)> {
+    let insulated = PLATE.replace(
+        "type = \"temperature\"\nvalue = 100.0",
+        "type = \"insulated\"",
+    );
+    vec![
+        (
+            "boundary value 1/0",
+            with_value("1/0"),
+            "boundary.x_min.value",
+        ),
+        (
+            "boundary value ln(0)",
+            with_value("ln(0)"),
+            "boundary.x_min.value",
+        ),
+        (
+            "source sqrt(-1)",
+            format!("{PLATE}[source]\nvalue = \"sqrt(-1)\"\n"),
+            "source.value",
+        ),
+        (
+            "steady, every boundary insulated",
+            insulated.replace("end = 2.0", "end = 2.0\nintegrator = \"steady\""),
+            "time.integrator",
+        ),
+        (
+            "adaptive, dt_max 1e-300",
+            PLATE.replace(
+                "end = 2.0",
+                "end = 2.0\nintegrator = \"crank_nicolson\"\ntolerance = 1e-3\ndt_max = 1e-300",
+            ),
+            "time.dt_max",
+        ),
+    ]
+}
+
+/// Each of them: `check` and `run` end with the same one line within 2 s (issue 36), and
+/// `run` writes nothing.
+#[test]
+fn what_run_refuses_check_refuses_within_two_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    for (k, (what, text, key)) in check_passed_run_refused().into_iter().enumerate() {
+        let name = format!("refused_{k}.toml");
+        let case = write_case(dir.path(), &name, &text);
+        let case = case.to_str().unwrap();
+        let out = dir.path().join(format!("out_{k}"));
+        let run = peritherm(&["run", case, "--out", out.to_str().unwrap()]);
+        assert_refused(what, &run, &name, key);
+        assert!(!out.exists(), "{what}: --out written");
+        let check = peritherm(&["check", case]);
+        assert_refused(what, &check, &name, key);
+        for (o, command) in [(&run, "run"), (&check, "check")] {
+            assert!(o.seconds < 2.0, "{what}: {command} took {:.2} s", o.seconds);
+        }
+        assert_eq!(
+            without_free_memory(&check.stderr),
+            without_free_memory(&run.stderr),
+            "{what}: check and run differ"
+        );
+    }
+}
+
 /// The message with the "(machine: … available" figure of the memory budget cut out (the
 /// " of " searched after it: the message says "80% of the available memory" before it).
 fn without_free_memory(msg: &str) -> String {
@@ -198,9 +263,10 @@ fn output_directories_are_transactional() {
     assert!(std::fs::read_to_string(out.join("run.json"))
         .unwrap()
         .contains("two.toml"));
-    // a source that overflows as t nears 3 s (1e308^(t - 1.5) is 1e154 at 2 s): fields 1 and
+    // a source that is finite at every output time (which `check` and the set-up evaluate)
+    // but infinite at t = 2.5 s, the midpoint stage of RK4's step from 2 to 3 s: fields 1 and
     // 2 are written, then the state turns non-finite before the third output
-    let blow = "[source]\nvalue = \"1e308^(t - 1.5)\"\n";
+    let blow = "[source]\nvalue = \"1/(t - 2.5)\"\n";
     let o = run_plate(dir.path(), "blow.toml", "1, 2, 3, 4, 5", blow, &out);
     assert_refused("non-finite", &o, "blow.toml", "source.value");
     let json = std::fs::read_to_string(out.join("run.json")).unwrap();

@@ -15,6 +15,7 @@ mod common {
 }
 
 mod cache;
+mod check_run;
 mod commands;
 mod figures;
 mod fuzz;

@@ -88,6 +88,7 @@ impl FaceBc {
 /// Nodes held at θ_b(x, t).
 #[derive(Debug, Clone)]
 struct Nodal {
+    face: usize,
     nodes: Vec<usize>,
     value: Expr,
 }
@@ -96,6 +97,7 @@ struct Nodal {
 /// of the end.
 #[derive(Debug, Clone)]
 struct Relation1d {
+    face: usize,
     slaved: Vec<(usize, f64)>,
     anchor: usize,
     value: Expr,
@@ -106,6 +108,7 @@ struct Relation1d {
 /// Bobaru & Duangpanya 2012 §3.2: θ_i = (Σ_p w_p θ_p + q) / Σ_p w_p over the inward half of H_i.
 #[derive(Debug, Clone)]
 struct RelationNodal {
+    face: usize,
     node: usize,
     stencil: Vec<(NodeId, f64)>,
     wsum: f64,
@@ -126,8 +129,20 @@ struct Ghost {
 /// Convection on surface nodes.
 #[derive(Debug, Clone)]
 struct Convective {
+    face: usize,
     nodes: Vec<(usize, f64)>,
     ambient: Expr,
+}
+
+/// A condition's expression, or the source, that is not finite at a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NonFinite {
+    /// The boundary set of the condition (None: the volumetric source).
+    pub face: Option<usize>,
+    /// Where it was evaluated, m.
+    pub at: Point,
+    /// The value there (NaN or ±inf), the condition's unit.
+    pub value: f64,
 }
 
 /// All boundary conditions and loads of a model, ready to apply.
@@ -183,6 +198,7 @@ impl Relation1d {
         }
         let a = anchor?;
         Some(Relation1d {
+            face,
             slaved: slaved.into_iter().map(|(i, d)| (i, best - d)).collect(),
             anchor: a,
             value: value.clone(),
@@ -218,6 +234,7 @@ impl RelationNodal {
             }
             if wsum > 0.0 {
                 out.push(RelationNodal {
+                    face,
                     node: i,
                     stencil,
                     wsum,
@@ -245,6 +262,7 @@ impl Boundary {
                 FaceBc::NodalTemperature { value, layers } => {
                     let nodes = cloud.set_layer(face, *layers);
                     b.nodal.push(Nodal {
+                        face,
                         nodes,
                         value: value.clone(),
                     });
@@ -265,6 +283,7 @@ impl Boundary {
                         .map(|(i, area)| (i, *h * area / (cloud.volume[i] * input.capacity[i])))
                         .collect();
                     b.convective.push(Convective {
+                        face,
                         nodes,
                         ambient: ambient.clone(),
                     });
@@ -403,6 +422,63 @@ impl Boundary {
                 terms,
             });
         }
+    }
+
+    /// The first place where a condition's expression or the source is not finite at time
+    /// `t` (s), each evaluated where [`Boundary::apply`] and [`Boundary::add_loads`] evaluate
+    /// it; None when all are finite.
+    pub fn non_finite(&self, cloud: &Cloud, t: f64) -> Option<NonFinite> {
+        let bad = |face: Option<usize>, e: &Expr, at: Point| {
+            let value = e.eval(at.x, at.y, at.z, t);
+            (!value.is_finite()).then_some(NonFinite { face, at, value })
+        };
+        let origin = Point::origin();
+        // a uniform value is the same at every node (apply takes it at the origin)
+        let nodal = self.nodal.iter().flat_map(|n| {
+            n.nodes
+                .iter()
+                .map(move |&i| (n.face, &n.value, cloud.pos[i]))
+        });
+        let relations = self.relation1d.iter().map(|r| (r.face, &r.value, r.at));
+        let nodal_relations = self
+            .relation_nodal
+            .iter()
+            .map(|r| (r.face, &r.value, cloud.pos[r.node]));
+        let ghosts = self.ghosts.iter().flat_map(|g| {
+            g.terms
+                .iter()
+                .filter_map(|&(fc, _, _, at)| match &self.faces[fc] {
+                    FaceBc::LayerTemperature { value, .. } | FaceBc::LayerFlux { value } => {
+                        Some((fc, value, at))
+                    }
+                    FaceBc::LayerConvection { ambient, .. } => Some((fc, ambient, at)),
+                    _ => None,
+                })
+        });
+        let convective = self.convective.iter().map(|c| (c.face, &c.ambient, origin));
+        let found = nodal
+            .chain(relations)
+            .chain(nodal_relations)
+            .chain(ghosts)
+            .chain(convective)
+            .find_map(|(face, e, at)| bad(Some(face), e, at));
+        found.or_else(|| self.source_non_finite(cloud, t))
+    }
+
+    /// The body node of lowest index where the source is not finite at `t` (s), if any.
+    fn source_non_finite(&self, cloud: &Cloud, t: f64) -> Option<NonFinite> {
+        use rayon::prelude::*;
+        let s = self.source.as_ref()?;
+        let i = (0..cloud.n_body).into_par_iter().find_first(|&i| {
+            let p = cloud.pos[i];
+            !s.eval(p.x, p.y, p.z, t).is_finite()
+        })?;
+        let at = cloud.pos[i];
+        Some(NonFinite {
+            face: None,
+            at,
+            value: s.eval(at.x, at.y, at.z, t),
+        })
     }
 
     /// Sets every constrained body node and every fictitious node at time `t`.

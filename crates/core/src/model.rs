@@ -382,21 +382,13 @@ impl Bonds {
             *w *= m;
         }
         let mut conductance = Conductance::assemble_rows(cloud, horizons, &weights, rows);
-        let (correction, consistent) =
-            if spec.consistency != Order::None && !cloud.symmetry.is_symmetric() {
-                let sel = complete_horizons(cloud, horizons, layered, mu);
-                let (c, met) = correct_reusing(
-                    &mut conductance,
-                    cloud,
-                    &sel,
-                    bond_conductivity,
-                    spec.consistency,
-                    store,
-                );
-                (Some(c), met)
-            } else {
-                (None, vec![false; cloud.n_body])
-            };
+        let (correction, consistent) = correction_of(
+            spec,
+            (cloud, horizons, layered, mu),
+            bond_conductivity,
+            &mut conductance,
+            store,
+        );
         let growth = pair_cuts(cloud, horizons, &conductance, &cuts.later);
         Bonds {
             weights,
@@ -423,6 +415,36 @@ impl Bonds {
                 .collect()
         })
     }
+}
+
+/// Whether `spec` asks for consistent weights where they apply (not on a symmetric cloud).
+fn corrects(spec: &ModelSpec, cloud: &Cloud) -> bool {
+    spec.consistency != Order::None && !cloud.symmetry.is_symmetric()
+}
+
+/// The consistency correction of `conductance` when `spec` asks for one ([`corrects`]), on
+/// the nodes whose horizon is complete (`layered`: the sets with a fictitious layer; `mu`:
+/// the bonds' cut factors), and which body nodes meet it.
+fn correction_of(
+    spec: &ModelSpec,
+    (cloud, horizons, layered, mu): (&Cloud, &Horizons, &[bool], &[f64]),
+    bond_conductivity: &[f64],
+    conductance: &mut Conductance,
+    store: Option<&dyn Store>,
+) -> (Option<Consistency>, Vec<bool>) {
+    if !corrects(spec, cloud) {
+        return (None, vec![false; cloud.n_body]);
+    }
+    let sel = complete_horizons(cloud, horizons, layered, mu);
+    let (c, met) = correct_reusing(
+        conductance,
+        cloud,
+        &sel,
+        bond_conductivity,
+        spec.consistency,
+        store,
+    );
+    (Some(c), met)
 }
 
 /// The enthalpy curves of a phase-change model with the conductivity and capacity bounds
@@ -511,6 +533,58 @@ impl Model {
         let horizons = Horizons::build(&cloud, &spec.kernel);
         let rows = 0..cloud.n_body;
         Self::finish(spec, cloud, horizons, phase, &layered, rows, store)
+    }
+
+    /// [`Model::build_with`], calling `check` on the model before its consistent weights are
+    /// solved (they are the expensive part of a set-up and change nothing `check` should
+    /// read but K): a case `check` refuses is refused in the time of a set-up without them.
+    /// The model is the same bits as [`Model::build_with`]'s.
+    pub fn build_checked(
+        spec: &ModelSpec,
+        store: Option<&dyn Store>,
+        check: impl Fn(&Model) -> Result<()>,
+    ) -> Result<Model> {
+        let bare = ModelSpec {
+            consistency: Order::None,
+            ..spec.clone()
+        };
+        let (phase, layered, cloud) = prelude(&bare)?;
+        let horizons = Horizons::build(&cloud, &bare.kernel);
+        let rows = 0..cloud.n_body;
+        let mut model = Self::finish(&bare, cloud, horizons, phase, &layered, rows, None)?;
+        check(&model)?;
+        if corrects(spec, &model.cloud) {
+            model.correct(spec, phase, &layered, store);
+        }
+        Ok(model)
+    }
+
+    /// Applies the consistency correction of `spec` to a model built without it (see
+    /// [`Model::build_checked`]); `phase`: K holds unit conductivities.
+    fn correct(
+        &mut self,
+        spec: &ModelSpec,
+        phase: bool,
+        layered: &[bool],
+        store: Option<&dyn Store>,
+    ) {
+        let cloud = &self.cloud;
+        let bond_conductivity = if phase {
+            vec![1.0; cloud.len()]
+        } else {
+            heat_of(spec, cloud).0
+        };
+        let cuts = bond_factors(cloud, &self.horizons, &cutters(cloud, &spec.cracks));
+        let (correction, consistent) = correction_of(
+            spec,
+            (cloud, &self.horizons, layered, &cuts.mu),
+            &bond_conductivity,
+            &mut self.conductance,
+            store,
+        );
+        self.growth = pair_cuts(cloud, &self.horizons, &self.conductance, &cuts.later);
+        self.correction = correction;
+        self.consistent = consistent;
     }
 
     /// Whether a spec can be built one rank's share at a time ([`Model::build_share`]): every

@@ -368,6 +368,17 @@ impl Implicit<'_> {
         };
         let mut next_output = 0;
         while next_output < outputs.len() {
+            let attempts = past.accepted + self.stats.rejected;
+            if attempts as f64 >= crate::limits::MAX_STEPS {
+                return Err(Error::model(
+                    "time.tolerance",
+                    format!(
+                        "{attempts} adaptive steps reached t = {:e} s of {t_last} s; at most {:e} are allowed (raise time.tolerance or time.dt_max)",
+                        past.t,
+                        crate::limits::MAX_STEPS
+                    ),
+                ));
+            }
             if ladder.k > MAX_RUNG {
                 return Err(Error::Solver {
                     message: format!(

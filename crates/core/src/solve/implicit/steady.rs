@@ -8,14 +8,10 @@ use crate::solve::exchange::Reduce;
 use crate::solve::stepper::RunStats;
 
 impl Implicit<'_> {
-    /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
-    /// `on_output(k, t, θ, K)` for each (theory §4).
-    pub fn steady(
-        &mut self,
-        theta: &mut [f64],
-        outputs: &[f64],
-        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
-    ) -> Result<RunStats> {
+    /// Refuses a steady problem whose boundary conditions leave the temperature level free
+    /// (every face insulated, free or a flux): its steady state is not unique. Reduced over
+    /// the ranks when distributed.
+    pub fn level_fixed(&self) -> Result<()> {
         let floating = match &self.ranks {
             Some(r) => {
                 let here = if self.sys.is_floating() { 1.0 } else { 0.0 };
@@ -28,6 +24,18 @@ impl Implicit<'_> {
                 "steady: no boundary condition fixes the temperature level (every face insulated or free, no temperature or convection condition); the steady state is not unique",
             ));
         }
+        Ok(())
+    }
+
+    /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
+    /// `on_output(k, t, θ, K)` for each (theory §4).
+    pub fn steady(
+        &mut self,
+        theta: &mut [f64],
+        outputs: &[f64],
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
+    ) -> Result<RunStats> {
+        self.level_fixed()?;
         for (k, &t) in outputs.iter().enumerate() {
             self.sys.forcing(
                 self.model,
