@@ -37,10 +37,20 @@ impl Initial {
             Initial::PerRegion(v) => region.iter().map(|&r| v[r as usize]).collect(),
         };
         match theta0.iter().position(|v| !v.is_finite()) {
-            Some(i) => Err(Error::model(
-                "initial",
-                format!("initial temperature is not finite at {what} {i}"),
-            )),
+            Some(i) => {
+                let p = pos[i];
+                let key = match self {
+                    Initial::Field(_) => "initial.value",
+                    Initial::PerRegion(_) => "initial",
+                };
+                Err(Error::model(
+                    key,
+                    format!(
+                        "not finite ({}) at {what} {i}, ({}, {}, {}) m, t = 0 s",
+                        theta0[i], p.x, p.y, p.z
+                    ),
+                ))
+            }
             None => Ok(theta0),
         }
     }
