@@ -85,9 +85,16 @@ fn refusals() -> Vec<(&'static str, String, &'static str)> {
 /// 5 s and 1 GiB, and `run` writes no `--out`.
 #[test]
 fn every_hostile_case_is_refused_alike_by_check_and_run() {
+    refused_alike(refusals(), "hostile", crate::common::hostile::MAX_SECONDS);
+}
+
+/// Each of `cases` (what, text, key), written as `<prefix>_<k>.toml`: `run` and `check` end
+/// with the same one line naming the file and the key, each within `seconds`, and `run`
+/// writes no `--out`.
+fn refused_alike(cases: Vec<(&'static str, String, &'static str)>, prefix: &str, seconds: f64) {
     let dir = tempfile::tempdir().unwrap();
-    for (k, (what, text, key)) in refusals().into_iter().enumerate() {
-        let name = format!("hostile_{k}.toml");
+    for (k, (what, text, key)) in cases.into_iter().enumerate() {
+        let name = format!("{prefix}_{k}.toml");
         let case = write_case(dir.path(), &name, &text);
         let case = case.to_str().unwrap();
         let out = dir.path().join(format!("out_{k}"));
@@ -96,6 +103,13 @@ fn every_hostile_case_is_refused_alike_by_check_and_run() {
         assert!(!out.exists(), "{what}: --out written");
         let check = peritherm(&["check", case]);
         assert_refused(what, &check, &name, key);
+        for (o, command) in [(&run, "run"), (&check, "check")] {
+            assert!(
+                o.seconds < seconds,
+                "{what}: {command} took {:.2} s",
+                o.seconds
+            );
+        }
         // the machine's free memory changes between the two calls: compared without it
         assert_eq!(
             without_free_memory(&check.stderr),
@@ -148,26 +162,7 @@ fn check_passed_run_refused() -> Vec<(&'static str, String, &'static str)> {
 /// `run` writes nothing.
 #[test]
 fn what_run_refuses_check_refuses_within_two_seconds() {
-    let dir = tempfile::tempdir().unwrap();
-    for (k, (what, text, key)) in check_passed_run_refused().into_iter().enumerate() {
-        let name = format!("refused_{k}.toml");
-        let case = write_case(dir.path(), &name, &text);
-        let case = case.to_str().unwrap();
-        let out = dir.path().join(format!("out_{k}"));
-        let run = peritherm(&["run", case, "--out", out.to_str().unwrap()]);
-        assert_refused(what, &run, &name, key);
-        assert!(!out.exists(), "{what}: --out written");
-        let check = peritherm(&["check", case]);
-        assert_refused(what, &check, &name, key);
-        for (o, command) in [(&run, "run"), (&check, "check")] {
-            assert!(o.seconds < 2.0, "{what}: {command} took {:.2} s", o.seconds);
-        }
-        assert_eq!(
-            without_free_memory(&check.stderr),
-            without_free_memory(&run.stderr),
-            "{what}: check and run differ"
-        );
-    }
+    refused_alike(check_passed_run_refused(), "refused", 2.0);
 }
 
 /// The message with the "(machine: … available" figure of the memory budget cut out (the
