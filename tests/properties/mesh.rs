@@ -473,3 +473,30 @@ fn graded_3d_mesh_neighbours_equal_a_brute_force_search() {
         brute.iter().map(Vec::len).sum::<usize>()
     );
 }
+
+/// Every committed mesh (meshes/ and the test fixtures that are meant to be valid) passes the
+/// integrity checks of `gmsh::read` (duplicated, overlapping, inverted or degenerate elements,
+/// repeated node tags, two groups of one dimension and name): the checks refuse no mesh gmsh
+/// wrote.
+#[test]
+fn every_committed_mesh_passes_the_integrity_checks() {
+    let mut files: Vec<PathBuf> = ["meshes", "tests/data"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root().join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "msh"))
+        .collect();
+    files.sort();
+    // the fixtures that are invalid on purpose (tests/data/make_fixtures.py)
+    let invalid = ["msh22", "no_groups", "second_order", "unmeshed"];
+    let mut read = 0;
+    for f in &files {
+        let stem = f.file_stem().unwrap().to_string_lossy();
+        if invalid.contains(&stem.as_ref()) {
+            continue;
+        }
+        gmsh::read(f).unwrap_or_else(|e| panic!("{e}"));
+        read += 1;
+    }
+    assert!(read >= 45, "only {read} meshes found");
+}

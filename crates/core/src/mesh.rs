@@ -2,7 +2,10 @@
 //!
 //! This is the neutral form between a mesh reader (`peritherm_io::gmsh`) and the cloud builder
 //! ([`crate::cloud::mesh`]); it holds no physics. Element geometry (centroid, measure) lives
-//! here because every consumer needs the same formulas.
+//! here because every consumer needs the same formulas; [`integrity`] finds the defects that
+//! make a mesh count volume twice.
+
+pub mod integrity;
 
 use crate::math::{Point, Vector};
 
@@ -115,6 +118,25 @@ impl Mesh {
             .position(|g| g.dim == dim && g.name == name)
     }
 
+    /// A node of an element of dimension `dim` that lies off the z = 0 plane (2D) or the x
+    /// axis (1D) by more than 1e-9 of the largest coordinate; `None` when all lie on it.
+    pub fn off_plane(&self, dim: usize) -> Option<usize> {
+        if dim >= 3 {
+            return None;
+        }
+        let extent = self
+            .nodes
+            .iter()
+            .map(|p| p.coords.amax())
+            .fold(0.0, f64::max);
+        let off = |p: &Point| p.z.abs() > 1e-9 * extent || (dim < 2 && p.y.abs() > 1e-9 * extent);
+        self.elements
+            .iter()
+            .filter(|e| e.kind.dim() == dim)
+            .flat_map(|e| e.nodes.iter().map(|&n| n as usize))
+            .find(|&n| off(&self.nodes[n]))
+    }
+
     /// Node positions of an element.
     pub fn corners(&self, e: &Element) -> Vec<Point> {
         e.nodes.iter().map(|&n| self.nodes[n as usize]).collect()
@@ -176,6 +198,49 @@ pub fn measure_and_centroid(kind: ElementKind, p: &[Point]) -> (f64, Point) {
                 .collect();
             weighted(&parts)
         }
+    }
+}
+
+/// True when `p` lies in the element of shape `kind` with corners `c` (boundary included,
+/// round-off tolerant; 2D elements in the z = 0 plane, 1D ones on the x axis).
+pub fn contains(kind: ElementKind, c: &[Point], p: &Point) -> bool {
+    let eps = 1e-12;
+    let tri = |a: &Point, b: &Point, d: &Point| -> bool {
+        let area = (b - a).cross(&(d - a)).z;
+        let s = area.signum();
+        let w = [
+            (b - p).cross(&(d - p)).z * s,
+            (d - p).cross(&(a - p)).z * s,
+            (a - p).cross(&(b - p)).z * s,
+        ];
+        w.iter().all(|&x| x >= -eps * area.abs())
+    };
+    let tet = |a: &Point, b: &Point, d: &Point, e: &Point| -> bool {
+        let vol =
+            |w: &Point, x: &Point, y: &Point, z: &Point| (x - w).cross(&(y - w)).dot(&(z - w));
+        let v = vol(a, b, d, e);
+        let s = v.signum();
+        [
+            vol(p, b, d, e),
+            vol(a, p, d, e),
+            vol(a, b, p, e),
+            vol(a, b, d, p),
+        ]
+        .iter()
+        .all(|&x| x * s >= -eps * v.abs())
+    };
+    match kind {
+        ElementKind::Point => false,
+        ElementKind::Line => {
+            let (lo, hi) = (c[0].x.min(c[1].x), c[0].x.max(c[1].x));
+            p.x >= lo && p.x <= hi
+        }
+        ElementKind::Triangle => tri(&c[0], &c[1], &c[2]),
+        ElementKind::Quad => tri(&c[0], &c[1], &c[2]) || tri(&c[0], &c[2], &c[3]),
+        ElementKind::Tet => tet(&c[0], &c[1], &c[2], &c[3]),
+        ElementKind::Hex => HEX_TETS
+            .iter()
+            .any(|t| tet(&c[t[0]], &c[t[1]], &c[t[2]], &c[t[3]])),
     }
 }
 

@@ -17,7 +17,7 @@ use mshio::{ElementType, MshFile, MshParserError};
 
 use peritherm_core::error::{Error, Result};
 use peritherm_core::math::Point;
-use peritherm_core::mesh::{Element, ElementKind, Group, Mesh};
+use peritherm_core::mesh::{integrity, Element, ElementKind, Group, Mesh};
 
 /// Physical group names by (dimension, tag).
 type Names = BTreeMap<(i32, i32), String>;
@@ -56,7 +56,19 @@ fn parse_bytes(bytes: &[u8]) -> Msg<Mesh> {
             let why = summary(bytes, &e);
             format!("the mesh is truncated or malformed (mshio: {why}); {REGENERATE}")
         })?;
-    build(&parsed, physical_names(bytes)?)
+    let tags = node_tags(bytes, binary)?;
+    let (mesh, element_tags) = build(&parsed, physical_names(bytes)?, &tags)?;
+    validate(&mesh, &tags, &element_tags)?;
+    Ok(mesh)
+}
+
+/// Refuses a mesh with a defect of [`integrity::validate`], naming the elements by their tags.
+fn validate(mesh: &Mesh, node_tags: &[u64], element_tags: &[u64]) -> Msg<()> {
+    integrity::validate(mesh).map_err(|d| {
+        let tag = |e: usize| element_tags[e];
+        let node = |n: usize| node_tags[n];
+        d.describe(mesh, &tag, &node)
+    })
 }
 
 fn fail(path: &Path, message: String) -> Error {
@@ -217,20 +229,22 @@ fn kind_of(t: ElementType) -> Option<ElementKind> {
 /// The mshio file type this reader parses.
 type Msh = MshFile<u64, i32, f64>;
 
-/// Assembles the mesh from mshio's sections and the physical names.
-fn build(msh: &Msh, mut names: Names) -> Msg<Mesh> {
+/// Assembles the mesh from mshio's sections, the physical names and the node tags in file
+/// order; returns it with the tag of every element.
+fn build(msh: &Msh, mut names: Names, tags: &[u64]) -> Msg<(Mesh, Vec<u64>)> {
     let entity_groups = entity_groups(msh, &mut names);
     let groups = GroupTable::new(names)?;
-    let nodes = NodeTable::read(msh)?;
-    let elements = read_elements(msh, &entity_groups, &groups, &nodes)?;
+    let nodes = NodeTable::read(msh, tags)?;
+    let (elements, element_tags) = read_elements(msh, &entity_groups, &groups, &nodes)?;
     if elements.is_empty() {
         return Err(no_mesh("elements in its physical groups"));
     }
-    Ok(Mesh {
+    let mesh = Mesh {
         nodes: nodes.nodes,
         elements,
         groups: groups.groups,
-    })
+    };
+    Ok((mesh, element_tags))
 }
 
 /// The physical tags of every (dimension, entity tag) of `$Entities`; every physical tag
@@ -260,10 +274,21 @@ struct GroupTable {
 }
 
 impl GroupTable {
-    /// The table of the named groups; an error when there is none or more than 65536.
+    /// The table of the named groups; an error when there is none, more than 65536, or two of
+    /// one dimension with one name.
     fn new(names: Names) -> Msg<GroupTable> {
         if names.is_empty() {
             return Err(NO_GROUPS.into());
+        }
+        let mut by_name: HashMap<(i32, &str), i32> = HashMap::new();
+        for (&(dim, tag), name) in &names {
+            if let Some(first) = by_name.insert((dim, name.as_str()), tag) {
+                return Err(format!(
+                    "physical groups {first} and {tag} of dimension {dim} are both named `{}`, so a \
+                     boundary or region of that name is ambiguous: rename one, or make them one group",
+                    name.escape_debug()
+                ));
+            }
         }
         let index: HashMap<(i32, i32), u16> = names.keys().copied().zip(0..=u16::MAX).collect();
         if index.len() < names.len() {
@@ -282,29 +307,47 @@ impl GroupTable {
 /// The nodes of `$Nodes` and how a node tag finds its index.
 struct NodeTable {
     nodes: Vec<Point>,
-    /// Index of each tag when the blocks list their tags.
+    /// Index of each tag when the tags are not consecutive in file order.
     sparse: HashMap<u64, usize>,
-    /// True when no block lists tags: node tags run from `min_tag` in order.
+    /// True when node tags run from `min_tag` in file order.
     dense: bool,
     min_tag: u64,
 }
 
 impl NodeTable {
-    /// Reads every node block; an error when there is no node.
-    fn read(msh: &Msh) -> Msg<NodeTable> {
+    /// Reads every node block with `tags`, the node tags in file order ([`node_tags`]); an
+    /// error when there is no node or a tag appears twice.
+    fn read(msh: &Msh, tags: &[u64]) -> Msg<NodeTable> {
         let blocks = msh.data.nodes.iter().flat_map(|n| &n.node_blocks);
-        let (mut nodes, mut sparse) = (Vec::new(), HashMap::new());
-        for block in blocks.clone() {
-            let offset = nodes.len();
-            let tags = block.node_tags.iter().flatten();
-            sparse.extend(tags.map(|(&tag, &i)| (tag, offset + i)));
-            nodes.extend(block.nodes.iter().map(|n| Point::new(n.x, n.y, n.z)));
-        }
+        let nodes: Vec<Point> = blocks
+            .flat_map(|b| b.nodes.iter().map(|n| Point::new(n.x, n.y, n.z)))
+            .collect();
         if nodes.is_empty() {
             return Err(no_mesh("nodes"));
         }
-        let dense = blocks.clone().all(|b| b.node_tags.is_none());
-        let min_tag = msh.data.nodes.as_ref().map_or(0, |n| n.min_node_tag);
+        if tags.len() != nodes.len() {
+            return Err(format!(
+                "the `$Nodes` section lists {} tags for {} nodes; {REGENERATE}",
+                tags.len(),
+                nodes.len()
+            ));
+        }
+        let min_tag = tags[0];
+        let dense = tags
+            .iter()
+            .enumerate()
+            .all(|(i, &t)| Some(t) == min_tag.checked_add(i as u64));
+        let mut sparse = HashMap::new();
+        if !dense {
+            sparse.reserve(tags.len());
+            for (i, &t) in tags.iter().enumerate() {
+                if sparse.insert(t, i).is_some() {
+                    return Err(format!(
+                        "node tag {t} appears twice in `$Nodes`, so the elements that name it are ambiguous; {REGENERATE}"
+                    ));
+                }
+            }
+        }
         Ok(NodeTable {
             nodes,
             sparse,
@@ -323,15 +366,112 @@ impl NodeTable {
     }
 }
 
+/// A reader of the numbers of a section, ASCII or binary (`Some(little_endian)`).
+struct Numbers<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    binary: Option<bool>,
+}
+
+impl Numbers<'_> {
+    /// The next ASCII token.
+    fn token(&mut self) -> Option<&[u8]> {
+        let rest = self.bytes.get(self.at..)?;
+        let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
+        let len = rest[start..]
+            .iter()
+            .position(|b| b.is_ascii_whitespace())
+            .unwrap_or(rest.len() - start);
+        self.at += start + len;
+        Some(&rest[start..start + len])
+    }
+
+    /// The next `width` bytes (binary).
+    fn raw<const W: usize>(&mut self) -> Option<[u8; W]> {
+        let b = self.bytes.get(self.at..self.at + W)?.try_into().ok()?;
+        self.at += W;
+        Some(b)
+    }
+
+    /// The next integer: an ASCII token, or a binary `int` (`wide` false) or `size_t`.
+    fn int(&mut self, wide: bool) -> Option<u64> {
+        let Some(little) = self.binary else {
+            return std::str::from_utf8(self.token()?).ok()?.parse().ok();
+        };
+        let v = match wide {
+            true => self.raw::<8>().map(|b| {
+                if little {
+                    u64::from_le_bytes(b)
+                } else {
+                    u64::from_be_bytes(b)
+                }
+            })?,
+            false => self.raw::<4>().map(|b| {
+                if little {
+                    i32::from_le_bytes(b)
+                } else {
+                    i32::from_be_bytes(b)
+                }
+            })? as u64,
+        };
+        Some(v)
+    }
+
+    /// Skips `n` numbers of 8 bytes (binary) or `n` tokens (ASCII).
+    fn skip(&mut self, n: u64) -> Option<()> {
+        match self.binary {
+            Some(_) => {
+                self.at = self
+                    .at
+                    .checked_add(usize::try_from(n).ok()?.checked_mul(8)?)?;
+                (self.at <= self.bytes.len()).then_some(())
+            }
+            None => (0..n).try_for_each(|_| self.token().map(|_| ())),
+        }
+    }
+}
+
+/// The node tags of `$Nodes` in file order (mshio drops them when they look consecutive, so a
+/// repeated or permuted tag would go unseen).
+fn node_tags(bytes: &[u8], binary: Option<bool>) -> Msg<Vec<u64>> {
+    let bad = || format!("the `$Nodes` section is malformed; {REGENERATE}");
+    let start = find(bytes, b"\n$Nodes").ok_or_else(|| no_mesh("nodes"))?;
+    let (_, at) = line_at(bytes, start + 1).ok_or_else(bad)?;
+    let mut r = Numbers { bytes, at, binary };
+    let header: Option<[u64; 4]> =
+        (|| Some([r.int(true)?, r.int(true)?, r.int(true)?, r.int(true)?]))();
+    let [blocks, count, _, _] = header.ok_or_else(bad)?;
+    let mut tags = Vec::with_capacity(usize::try_from(count).unwrap_or(0).min(bytes.len() / 8));
+    for _ in 0..blocks {
+        let block = (|| {
+            let dim = r.int(false)?;
+            let _entity = r.int(false)?;
+            let parametric = r.int(false)?;
+            let n = r.int(true)?;
+            // x y z, and u (v, w) up to the entity's dimension when parametric
+            let per_node = 3 + if parametric == 1 { dim.min(3) } else { 0 };
+            (parametric <= 1).then_some((n, per_node))
+        })();
+        let (n, per_node) = block.ok_or_else(bad)?;
+        for _ in 0..n {
+            tags.push(r.int(true).ok_or_else(bad)?);
+        }
+        r.skip(n.checked_mul(per_node).ok_or_else(bad)?)
+            .ok_or_else(bad)?;
+    }
+    Ok(tags)
+}
+
 /// The supported elements of the entities that belong to a physical group, each with its
-/// groups; an error for an unsupported type, a type of the wrong dimension or a missing node.
+/// groups, and their tags; an error for an unsupported type, a type of the wrong dimension or
+/// a missing node.
 fn read_elements(
     msh: &Msh,
     entity_groups: &HashMap<(i32, i32), &[i32]>,
     groups: &GroupTable,
     nodes: &NodeTable,
-) -> Msg<Vec<Element>> {
-    let mut elements = Vec::new();
+) -> Msg<(Vec<Element>, Vec<u64>)> {
+    let (mut elements, mut tags) = (Vec::new(), Vec::new());
     for block in msh.data.elements.iter().flat_map(|e| &e.element_blocks) {
         let (dim, t) = (block.entity_dim, block.element_type);
         let Some(physical) = entity_groups.get(&(dim, block.entity_tag)) else {
@@ -368,9 +508,10 @@ fn read_elements(
                 nodes,
                 groups: member.clone(),
             });
+            tags.push(tag);
         }
     }
-    Ok(elements)
+    Ok((elements, tags))
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use super::order::morton_order;
 use super::{Cloud, Fictitious, HorizonRule, MeshSides, Reflection, Sides};
 use crate::error::{Error, Result};
 use crate::math::{NodeId, Point, Vector};
-use crate::mesh::{measure_and_centroid, Element, ElementKind, Mesh, HEX_TETS};
+use crate::mesh::{contains, measure_and_centroid, Element, ElementKind, Mesh};
 use crate::spatial::PointIndex;
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -128,7 +128,7 @@ impl MeshGeometry {
             .iter()
             .filter(|e| e.kind.dim() == dim)
             .collect();
-        check_flat(mesh, &cells, dim)?;
+        check_flat(mesh, dim)?;
         let raw = self.body_nodes(&cells, dim)?;
         // body nodes at centroids, in Morton order
         let perm = morton_order(&raw.iter().map(|r| r.1).collect::<Vec<_>>());
@@ -362,32 +362,23 @@ fn facet_counts(cells: &[&Element], new_of: &[u32]) -> FacetCounts {
     faces
 }
 
-/// Checks that a 2D mesh lies in the z = 0 plane and a 1D mesh on the x axis (to 1e-9 of
-/// the largest coordinate).
-fn check_flat(mesh: &Mesh, cells: &[&Element], dim: usize) -> Result<()> {
-    let extent = mesh
-        .nodes
-        .iter()
-        .map(|p| p.coords.amax())
-        .fold(0.0, f64::max);
-    for e in cells {
-        for &n in &e.nodes {
-            let p = mesh.nodes[n as usize];
-            if (dim < 3 && p.z.abs() > 1e-9 * extent) || (dim < 2 && p.y.abs() > 1e-9 * extent) {
-                return Err(Error::model(
-                    "mesh",
-                    format!(
-                        "a {dim}D mesh must lie in the {} (node at {}, {}, {})",
-                        if dim == 2 { "z = 0 plane" } else { "x axis" },
-                        p.x,
-                        p.y,
-                        p.z
-                    ),
-                ));
-            }
-        }
-    }
-    Ok(())
+/// Checks that a 2D mesh lies in the z = 0 plane and a 1D mesh on the x axis
+/// ([`Mesh::off_plane`]).
+fn check_flat(mesh: &Mesh, dim: usize) -> Result<()> {
+    let Some(n) = mesh.off_plane(dim) else {
+        return Ok(());
+    };
+    let p = mesh.nodes[n];
+    Err(Error::model(
+        "mesh",
+        format!(
+            "a {dim}D mesh must lie in the {} (node at {}, {}, {})",
+            if dim == 2 { "z = 0 plane" } else { "x axis" },
+            p.x,
+            p.y,
+            p.z
+        ),
+    ))
 }
 
 /// Finds whether a point lies in the body, from the cells next to it.
@@ -404,7 +395,7 @@ impl Locator<'_> {
         let q = Point::from(p.coords / self.scale);
         self.index.nearest(p, 12).into_iter().any(|(k, _)| {
             let e = self.cells[k];
-            element_contains(e.kind, &self.mesh.corners(e), &q)
+            contains(e.kind, &self.mesh.corners(e), &q)
         })
     }
 }
@@ -480,48 +471,6 @@ fn mirror_layers(c: &mut Cloud, sides: &MeshSides, locate: &Locator, layered: &[
             of: i as NodeId,
             chain,
         });
-    }
-}
-
-/// True when `p` lies in the element with corners `c` (boundary included, round-off tolerant).
-fn element_contains(kind: ElementKind, c: &[Point], p: &Point) -> bool {
-    let eps = 1e-12;
-    let tri = |a: &Point, b: &Point, d: &Point| -> bool {
-        let area = (b - a).cross(&(d - a)).z;
-        let s = area.signum();
-        let w = [
-            (b - p).cross(&(d - p)).z * s,
-            (d - p).cross(&(a - p)).z * s,
-            (a - p).cross(&(b - p)).z * s,
-        ];
-        w.iter().all(|&x| x >= -eps * area.abs())
-    };
-    let tet = |a: &Point, b: &Point, d: &Point, e: &Point| -> bool {
-        let vol =
-            |w: &Point, x: &Point, y: &Point, z: &Point| (x - w).cross(&(y - w)).dot(&(z - w));
-        let v = vol(a, b, d, e);
-        let s = v.signum();
-        [
-            vol(p, b, d, e),
-            vol(a, p, d, e),
-            vol(a, b, p, e),
-            vol(a, b, d, p),
-        ]
-        .iter()
-        .all(|&x| x * s >= -eps * v.abs())
-    };
-    match kind {
-        ElementKind::Point => false,
-        ElementKind::Line => {
-            let (lo, hi) = (c[0].x.min(c[1].x), c[0].x.max(c[1].x));
-            p.x >= lo && p.x <= hi
-        }
-        ElementKind::Triangle => tri(&c[0], &c[1], &c[2]),
-        ElementKind::Quad => tri(&c[0], &c[1], &c[2]) || tri(&c[0], &c[2], &c[3]),
-        ElementKind::Tet => tet(&c[0], &c[1], &c[2], &c[3]),
-        ElementKind::Hex => HEX_TETS
-            .iter()
-            .any(|t| tet(&c[t[0]], &c[t[1]], &c[t[2]], &c[t[3]])),
     }
 }
 
