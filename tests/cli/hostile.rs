@@ -443,31 +443,105 @@ fn an_overflowing_reference_is_not_an_exact_match() {
     }
 }
 
-/// A mesh with a duplicated element and a region naming an empty group are refused.
+/// A case on the mesh file `file` (absolute path) with one region `plate`, or `regions`.
+fn mesh_case(file: &Path, regions: &str) -> String {
+    format!(
+        "dimension = 2\n[mesh]\nfile = \"{}\"\n{regions}[material.steel]\nconductivity = 50.0\n\
+         density = 7850.0\nspecific_heat = 420.0\n[boundary.left]\ntype = \"temperature\"\n\
+         value = 100.0\n[time]\nend = 2.0\n",
+        file.display()
+    )
+}
+
+const PLATE_REGION: &str = "[[region]]\nname = \"plate\"\nhorizon = { factor = 3.0 }\n";
+
+/// Text replacements in a file: (from, to), each made once.
+type Edits = Vec<(&'static str, &'static str)>;
+
+/// Issue 36's mesh examples, which ran without a word, edited from `tests/data/square_quad.msh`
+/// into `dir`: an element counted twice, a node tag given twice, two boundaries named `left`.
+fn silently_wrong_meshes(dir: &Path) -> Vec<(&'static str, String, &'static str)> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square_quad.msh");
+    let mesh = std::fs::read_to_string(src).unwrap();
+    let edits: [(&str, &str, Edits); 3] = [
+        (
+            "duplicated element",
+            "dup.msh",
+            vec![
+                ("$Elements\n5 96 1 96\n", "$Elements\n5 97 1 97\n"),
+                ("2 1 3 64\n", "2 1 3 65\n"),
+                ("33 1 5 33 32 \n", "33 1 5 33 32 \n97 1 5 33 32 \n"),
+            ],
+        ),
+        (
+            "duplicated node tag",
+            "dupnode.msh",
+            vec![("\n5\n6\n7\n", "\n5\n5\n7\n")],
+        ),
+        (
+            "two groups named left",
+            "dupname.msh",
+            vec![("1 2 \"bottom\"", "1 2 \"left\"")],
+        ),
+    ];
+    let mut cases = Vec::new();
+    for (what, name, replacements) in edits {
+        let mut text = mesh.clone();
+        for (from, to) in replacements {
+            assert!(
+                text.contains(from),
+                "{what}: the fixture changed: update this edit"
+            );
+            text = text.replacen(from, to, 1);
+        }
+        std::fs::write(dir.join(name), text).unwrap();
+        cases.push((what, mesh_case(&dir.join(name), PLATE_REGION), "mesh.file"));
+    }
+    cases
+}
+
+// Each of issue 36's silently wrong meshes is refused alike by check and run, within 2 s,
+// naming the mesh file and the entity, with nothing written.
 #[test]
-fn duplicated_elements_and_empty_regions_are_refused() {
+fn silently_wrong_meshes_are_refused_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = silently_wrong_meshes(dir.path());
+    let entities = [
+        "elements 33 and 97",
+        "node tag 5 appears twice",
+        "named `left`",
+    ];
+    for ((what, text, _), entity) in cases.iter().zip(entities) {
+        let case = write_case(dir.path(), "named.toml", text);
+        let o = peritherm(&["check", case.to_str().unwrap()]);
+        assert!(
+            o.stderr.contains(".msh: "),
+            "{what}: names no mesh file: {}",
+            o.stderr
+        );
+        assert!(
+            o.stderr.contains(entity),
+            "{what}: names no `{entity}`: {}",
+            o.stderr
+        );
+    }
+    refused_alike(cases, "mesh", 2.0);
+}
+
+#[test]
+fn an_empty_region_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square_quad.msh");
     let mesh = std::fs::read_to_string(src).unwrap();
-    let dup = mesh
-        .replace("$Elements\n5 96 1 96\n", "$Elements\n5 97 1 97\n")
-        .replace("2 1 3 64\n", "2 1 3 65\n")
-        .replace("33 1 5 33 32 \n", "33 1 5 33 32 \n97 1 5 33 32 \n");
-    assert_ne!(dup, mesh, "the fixture changed: update this edit");
-    std::fs::write(dir.path().join("dup.msh"), dup).unwrap();
     let empty = mesh.replace("5\n1 2 \"bottom\"", "6\n2 9 \"hole\"\n1 2 \"bottom\"");
+    assert_ne!(empty, mesh, "the fixture changed: update this edit");
     std::fs::write(dir.path().join("empty.msh"), empty).unwrap();
-    let case = |file: &str, regions: &str| {
-        format!(
-            "dimension = 2\n[mesh]\nfile = \"{file}\"\n{regions}[material.steel]\nconductivity = 50.0\ndensity = 7850.0\nspecific_heat = 420.0\n[boundary.left]\ntype = \"temperature\"\nvalue = 100.0\n[time]\nend = 2.0\n"
-        )
-    };
-    let plate = "[[region]]\nname = \"plate\"\nhorizon = { factor = 3.0 }\n";
-    let c = write_case(dir.path(), "dup.toml", &case("dup.msh", plate));
-    let o = peritherm(&["check", c.to_str().unwrap()]);
-    assert_refused("duplicated element", &o, "dup.toml", "mesh.file");
-    let hole = format!("{plate}[[region]]\nname = \"hole\"\nhorizon = {{ factor = 3.0 }}\n");
-    let c = write_case(dir.path(), "empty.toml", &case("empty.msh", &hole));
+    let hole = format!("{PLATE_REGION}[[region]]\nname = \"hole\"\nhorizon = {{ factor = 3.0 }}\n");
+    let c = write_case(
+        dir.path(),
+        "empty.toml",
+        &mesh_case(&dir.path().join("empty.msh"), &hole),
+    );
     let o = peritherm(&["check", c.to_str().unwrap()]);
     assert_refused("empty region", &o, "empty.toml", "region[1].name");
 }

@@ -284,8 +284,9 @@ impl GroupTable {
         for (&(dim, tag), name) in &names {
             if let Some(first) = by_name.insert((dim, name.as_str()), tag) {
                 return Err(format!(
-                    "physical groups {first} and {tag} of dimension {dim} are both named `{}`, so a \
-                     boundary or region of that name is ambiguous: rename one, or make them one group",
+                    "physical groups {first} and {tag} of dimension {dim} are both named `{}`, so \
+                     a boundary or region of that name is ambiguous: rename one, or make them \
+                     one group",
                     name.escape_debug()
                 ));
             }
@@ -343,7 +344,8 @@ impl NodeTable {
             for (i, &t) in tags.iter().enumerate() {
                 if sparse.insert(t, i).is_some() {
                     return Err(format!(
-                        "node tag {t} appears twice in `$Nodes`, so the elements that name it are ambiguous; {REGENERATE}"
+                        "node tag {t} appears twice in `$Nodes`, so the elements that name it \
+                         are ambiguous; {REGENERATE}"
                     ));
                 }
             }
@@ -558,5 +560,42 @@ mod tests {
             "$PhysicalNames\n2\n2 7 \"a\"\n$EndPhysicalNames\n$Entities",
         );
         assert!(message(&names).contains("2 names announced, 1 found"));
+    }
+
+    // Node tags come from the file, not from mshio (which drops them when they look
+    // consecutive): a repeated tag is refused, whether the tags look dense or sparse, and a
+    // permuted dense list maps by tag.
+    #[test]
+    fn node_tags_are_read_from_the_file() {
+        let repeated = SPARSE.replace("10\n20\n30", "10\n20\n10");
+        assert!(message(&repeated).contains("node tag 10 appears twice"));
+        let dense = SPARSE
+            .replace("1 3 10 30", "1 3 1 3")
+            .replace("10\n20\n30", "1\n2\n3");
+        let dense = dense.replace("1 30 10 20", "1 3 1 2");
+        let mesh = parse(dense.as_bytes(), Path::new("t.msh")).expect("valid");
+        assert_eq!(mesh.elements[0].nodes, [2, 0, 1]);
+        assert!(message(&dense.replace("1\n2\n3", "1\n2\n2")).contains("node tag 2 appears twice"));
+        let permuted = parse(
+            dense.replace("1\n2\n3", "3\n1\n2").as_bytes(),
+            Path::new("t.msh"),
+        );
+        assert_eq!(permuted.expect("valid").elements[0].nodes, [0, 1, 2]);
+    }
+
+    // Two physical groups of one dimension with one name are refused; of two dimensions, not.
+    #[test]
+    fn one_name_for_two_groups_of_one_dimension_is_refused() {
+        let two = |d: i32| {
+            let names =
+                format!("$PhysicalNames\n2\n2 7 \"a\"\n{d} 8 \"a\"\n$EndPhysicalNames\n$Entities");
+            SPARSE.replace("$Entities", &names)
+        };
+        let m = message(&two(2));
+        assert!(
+            m.contains("physical groups 7 and 8 of dimension 2 are both named `a`"),
+            "{m}"
+        );
+        assert!(parse(two(1).as_bytes(), Path::new("t.msh")).is_ok());
     }
 }

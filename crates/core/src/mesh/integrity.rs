@@ -131,8 +131,9 @@ fn shape_defect(kind: ElementKind, p: &[Point], k: usize) -> Option<Defect> {
         .fold(0.0, f64::max);
     let scale = p.iter().map(|q| q.coords.amax()).fold(0.0, f64::max);
     let (measure, _) = super::measure_and_centroid(kind, p);
-    let degenerate = !(longest > 1e-14 * scale) || !(measure > DEGENERATE * longest.powi(d as i32));
-    if degenerate {
+    // written so that a NaN coordinate counts as degenerate
+    let sound = longest > 1e-14 * scale && measure > DEGENERATE * longest.powi(d as i32);
+    if !sound {
         return Some(Defect::Degenerate { element: k });
     }
     let tangled = match kind {
@@ -143,14 +144,23 @@ fn shape_defect(kind: ElementKind, p: &[Point], k: usize) -> Option<Defect> {
     tangled.then_some(Defect::Tangled { element: k })
 }
 
-/// True when the quadrangle's four corner triangles turn the same way (a convex quadrangle;
-/// a straight corner is accepted).
+/// True when the quadrangle's four corners turn the same way (a convex quadrangle; a
+/// straight corner is accepted): every corner's turn agrees with the largest one.
 fn quad_is_convex(p: &[Point]) -> bool {
-    let n = (p[2] - p[0]).cross(&(p[3] - p[1]));
-    (0..4).all(|i| {
-        let (a, b, c) = (p[(i + 3) % 4], p[i], p[(i + 1) % 4]);
-        (b - a).cross(&(c - b)).dot(&n) >= -DEGENERATE * n.norm_squared()
-    })
+    let turns: Vec<Vector> = (0..4)
+        .map(|i| {
+            let (a, b, c) = (p[(i + 3) % 4], p[i], p[(i + 1) % 4]);
+            (b - a).cross(&(c - b))
+        })
+        .collect();
+    let largest = turns
+        .iter()
+        .copied()
+        .max_by(|x, y| x.norm_squared().total_cmp(&y.norm_squared()))
+        .unwrap_or_default();
+    turns
+        .iter()
+        .all(|t| t.dot(&largest) >= -DEGENERATE * largest.norm_squared())
 }
 
 /// True when the six tetrahedra of the hexahedron ([`HEX_TETS`]) have one orientation.
@@ -364,44 +374,68 @@ impl Defect {
         node: &dyn Fn(usize) -> u64,
     ) -> String {
         let dim = mesh.dim();
-        let kind = |e: usize| kind_name(mesh.elements[e].kind);
-        let kinds = |e: usize| kinds_name(mesh.elements[e].kind);
         let at = |e: usize| {
             let c = centre(mesh, &mesh.elements[e]);
             format!("({}, {}, {})", c.x, c.y, c.z)
         };
-        let measure = measure_name(dim);
+        let element_dim = |e: usize| mesh.elements[e].kind.dim();
+        let one = |e: usize| {
+            let kind = kind_name(mesh.elements[e].kind);
+            format!("element {} ({kind} at {})", tag(e), at(e))
+        };
+        let pair = |a: usize, b: usize| {
+            let kinds = kinds_name(mesh.elements[a].kind);
+            format!("elements {} and {} ({kinds} at {})", tag(a), tag(b), at(a))
+        };
+        let (measure, facet) = (measure_name(dim), facet_name(dim));
         const REGENERATE: &str = "regenerate the mesh with gmsh";
         match *self {
             Defect::OffPlane { node: n } => {
                 let p = mesh.nodes[n];
                 let place = if dim == 2 { "z = 0 plane" } else { "x axis" };
-                format!("node {} at ({}, {}, {}) is off the {place}: a {dim}D mesh must lie in it", node(n), p.x, p.y, p.z)
+                let (tag, (x, y, z)) = (node(n), (p.x, p.y, p.z));
+                format!(
+                    "node {tag} at ({x}, {y}, {z}) is off the {place}: a {dim}D mesh lies in it"
+                )
             }
             Defect::Degenerate { element: e } => format!(
-                "element {} ({} at {}) has zero {}: its corners lie on one {}; {REGENERATE}",
-                tag(e), kind(e), at(e), measure_name(mesh.elements[e].kind.dim()),
-                ["point", "point", "line", "plane"][mesh.elements[e].kind.dim()]
+                "{} has zero {}: its corners lie on one {}; {REGENERATE}",
+                one(e),
+                measure_name(element_dim(e)),
+                ["point", "point", "line", "plane"][element_dim(e)]
             ),
             Defect::Tangled { element: e } => format!(
-                "element {} ({} at {}) is tangled: its corners are not in gmsh's order (it is not convex or folds over itself); {REGENERATE}",
-                tag(e), kind(e), at(e)
+                "{} is tangled: its corners are not in gmsh's order (it is not convex or folds \
+                 over itself); {REGENERATE}",
+                one(e)
             ),
             Defect::Duplicated { first, second } => format!(
-                "elements {} and {} ({} at {}) have the same nodes, so their {} would be counted twice: remove one, or {REGENERATE}",
-                tag(first), tag(second), kinds(first), at(first), measure_name(mesh.elements[first].kind.dim())
+                "{} have the same nodes, so their {} would be counted twice: remove one, or \
+                 {REGENERATE}",
+                pair(first, second),
+                measure_name(element_dim(first))
             ),
-            Defect::Crowded { elements: [a, b, c] } => format!(
-                "elements {}, {} and {} share one {} near {}: overlapping elements would count the {measure} twice; {REGENERATE}",
-                tag(a), tag(b), tag(c), facet_name(dim), at(a)
+            Defect::Crowded {
+                elements: [a, b, c],
+            } => format!(
+                "elements {}, {} and {} share one {facet} near {}: overlapping elements would \
+                 count the {measure} twice; {REGENERATE}",
+                tag(a),
+                tag(b),
+                tag(c),
+                at(a)
             ),
             Defect::Folded { first, second } => format!(
-                "elements {} and {} ({} at {}) lie on the same side of the {} they share: one is inverted and they overlap; {REGENERATE}",
-                tag(first), tag(second), kinds(first), at(first), facet_name(dim)
+                "{} lie on the same side of the {facet} they share: one is inverted and they \
+                 overlap; {REGENERATE}",
+                pair(first, second)
             ),
             Defect::Overlapping { inner, outer } => format!(
-                "element {} ({} at {}) lies inside element {}: overlapping {} would count the {measure} twice; make them one conforming mesh (e.g. BooleanFragments in the .geo) and mesh again",
-                tag(inner), kind(inner), at(inner), tag(outer), ["points", "lines", "surfaces", "volumes"][dim]
+                "{} lies inside element {}: overlapping {} would count the {measure} twice; make \
+                 them one conforming mesh (e.g. BooleanFragments in the .geo) and mesh again",
+                one(inner),
+                tag(outer),
+                ["points", "lines", "surfaces", "volumes"][dim]
             ),
         }
     }
@@ -439,4 +473,292 @@ fn measure_name(dim: usize) -> &'static str {
 /// End point, edge or face: a facet of a body of dimension `dim`.
 fn facet_name(dim: usize) -> &'static str {
     ["point", "end point", "edge", "face"][dim.min(3)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn element(kind: ElementKind, nodes: &[u32]) -> Element {
+        Element {
+            kind,
+            nodes: nodes.to_vec(),
+            groups: vec![0],
+        }
+    }
+
+    /// The unit square cut into n × n squares of two triangles each, every triangle turning
+    /// counter-clockwise, nodes numbered from `first` and shifted by (`dx`, `dy`).
+    fn triangles(n: u32, first: u32, dx: f64, dy: f64) -> (Vec<Point>, Vec<Element>) {
+        let h = 1.0 / n as f64;
+        let nodes = (0..=n)
+            .flat_map(|j| {
+                (0..=n).map(move |i| Point::new(dx + i as f64 * h, dy + j as f64 * h, 0.0))
+            })
+            .collect();
+        let at = |i: u32, j: u32| first + j * (n + 1) + i;
+        let mut elements = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                elements.push(element(ElementKind::Triangle, &[a, b, c]));
+                elements.push(element(ElementKind::Triangle, &[a, c, d]));
+            }
+        }
+        (nodes, elements)
+    }
+
+    fn square(n: u32) -> Mesh {
+        let (nodes, elements) = triangles(n, 0, 0.0, 0.0);
+        Mesh {
+            nodes,
+            elements,
+            groups: Vec::new(),
+        }
+    }
+
+    fn unit_cube() -> Vec<Point> {
+        [
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [1., 0., 1.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+        ]
+        .iter()
+        .map(|p| Point::new(p[0], p[1], p[2]))
+        .collect()
+    }
+
+    fn mesh(nodes: Vec<Point>, elements: Vec<Element>) -> Mesh {
+        Mesh {
+            nodes,
+            elements,
+            groups: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_conforming_mesh_of_any_orientation_passes() {
+        let mut m = square(6);
+        assert_eq!(validate(&m), Ok(()));
+        // gmsh writes a clockwise curve loop's surface clockwise; mixed orientations are legal
+        for e in m.elements.iter_mut().step_by(3) {
+            e.nodes.reverse();
+        }
+        assert_eq!(validate(&m), Ok(()));
+        for e in &mut m.elements {
+            e.nodes.reverse();
+        }
+        assert_eq!(validate(&m), Ok(()));
+    }
+
+    #[test]
+    fn boundary_elements_and_a_hanging_node_interface_pass() {
+        // left square of two triangles, right square of four with a node at (1, 0.5)
+        let p = |x: f64, y: f64| Point::new(x, y, 0.0);
+        let nodes = vec![
+            p(0., 0.),
+            p(1., 0.),
+            p(1., 1.),
+            p(0., 1.),
+            p(2., 0.),
+            p(2., 1.),
+            p(1., 0.5),
+        ];
+        let t = |n: &[u32]| element(ElementKind::Triangle, n);
+        let mut elements = vec![t(&[0, 1, 2]), t(&[0, 2, 3])];
+        elements.extend([t(&[1, 4, 6]), t(&[4, 5, 6]), t(&[5, 2, 6])]);
+        elements.push(element(ElementKind::Line, &[0, 1]));
+        elements.push(element(ElementKind::Line, &[1, 4]));
+        elements.push(element(ElementKind::Point, &[0]));
+        assert_eq!(validate(&mesh(nodes, elements)), Ok(()));
+    }
+
+    #[test]
+    fn a_duplicated_element_is_refused() {
+        let mut m = square(4);
+        let copy = m.elements[5].clone();
+        m.elements.push(copy);
+        let last = m.elements.len() - 1;
+        assert_eq!(
+            validate(&m),
+            Err(Defect::Duplicated {
+                first: 5,
+                second: last
+            })
+        );
+        // the same nodes in another order are the same element
+        m.elements[last].nodes.rotate_left(1);
+        assert_eq!(
+            validate(&m),
+            Err(Defect::Duplicated {
+                first: 5,
+                second: last
+            })
+        );
+    }
+
+    #[test]
+    fn a_duplicated_boundary_line_is_refused() {
+        let mut m = square(2);
+        m.elements.push(element(ElementKind::Line, &[0, 1]));
+        m.elements.push(element(ElementKind::Line, &[1, 0]));
+        let n = m.elements.len();
+        assert_eq!(
+            validate(&m),
+            Err(Defect::Duplicated {
+                first: n - 2,
+                second: n - 1
+            })
+        );
+    }
+
+    #[test]
+    fn a_copy_with_its_own_nodes_laid_over_the_mesh_is_refused() {
+        let mut m = square(4);
+        let (nodes, elements) = triangles(2, m.nodes.len() as u32, 0.3, 0.2);
+        let first_copy = m.elements.len();
+        m.nodes.extend(nodes);
+        m.elements.extend(elements);
+        match validate(&m) {
+            Err(Defect::Overlapping { inner, outer }) => {
+                // one of the pair is in the copy, the other in the square
+                assert!(
+                    (inner < first_copy) != (outer < first_copy),
+                    "{inner} {outer}"
+                );
+            }
+            other => panic!("expected an overlap, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn overlapping_lines_are_refused() {
+        let nodes = [0.0, 1.0, 0.5, 1.5]
+            .map(|x| Point::new(x, 0.0, 0.0))
+            .to_vec();
+        let lines = vec![
+            element(ElementKind::Line, &[0, 1]),
+            element(ElementKind::Line, &[2, 3]),
+        ];
+        assert_eq!(
+            validate(&mesh(nodes, lines)),
+            Err(Defect::Overlapping { inner: 0, outer: 1 })
+        );
+    }
+
+    #[test]
+    fn an_inverted_neighbour_is_refused() {
+        // both triangles above their shared edge 0–1
+        let p = |x: f64, y: f64| Point::new(x, y, 0.0);
+        let nodes = vec![p(0., 0.), p(1., 0.), p(0.2, 1.), p(0.8, 0.5)];
+        let t = |n: &[u32]| element(ElementKind::Triangle, n);
+        let m = mesh(nodes, vec![t(&[0, 1, 2]), t(&[1, 0, 3])]);
+        assert_eq!(
+            validate(&m),
+            Err(Defect::Folded {
+                first: 0,
+                second: 1
+            })
+        );
+    }
+
+    #[test]
+    fn an_interior_node_pulled_across_an_edge_is_refused() {
+        let mut m = square(4);
+        // node (2, 2) of the 5 × 5 grid moved past its neighbours' far edge
+        m.nodes[12].x += 0.3;
+        assert!(
+            matches!(validate(&m), Err(Defect::Folded { .. })),
+            "{:?}",
+            validate(&m)
+        );
+    }
+
+    #[test]
+    fn an_edge_shared_by_three_triangles_is_refused() {
+        let p = |x: f64, y: f64| Point::new(x, y, 0.0);
+        let nodes = vec![p(0., 0.), p(1., 0.), p(0.5, 1.), p(0.5, -1.), p(0.5, 2.)];
+        let t = |n: &[u32]| element(ElementKind::Triangle, n);
+        let m = mesh(nodes, vec![t(&[0, 1, 2]), t(&[1, 0, 3]), t(&[0, 1, 4])]);
+        assert_eq!(
+            validate(&m),
+            Err(Defect::Crowded {
+                elements: [0, 1, 2]
+            })
+        );
+    }
+
+    #[test]
+    fn elements_of_zero_measure_are_refused() {
+        let mut m = square(2);
+        m.nodes.push(Point::new(0.5, 0.0, 0.0));
+        m.elements.push(element(ElementKind::Triangle, &[0, 1, 9]));
+        let k = m.elements.len() - 1;
+        assert_eq!(validate(&m), Err(Defect::Degenerate { element: k }));
+        m.elements[k] = element(ElementKind::Line, &[3, 3]);
+        assert_eq!(validate(&m), Err(Defect::Degenerate { element: k }));
+    }
+
+    #[test]
+    fn a_bow_tie_quadrangle_is_refused() {
+        let p = |x: f64, y: f64| Point::new(x, y, 0.0);
+        let nodes = vec![p(0., 0.), p(1., 0.), p(1., 1.), p(0., 1.)];
+        let good = mesh(
+            nodes.clone(),
+            vec![element(ElementKind::Quad, &[0, 1, 2, 3])],
+        );
+        assert_eq!(validate(&good), Ok(()));
+        let bad = mesh(nodes, vec![element(ElementKind::Quad, &[0, 1, 3, 2])]);
+        assert_eq!(validate(&bad), Err(Defect::Tangled { element: 0 }));
+    }
+
+    #[test]
+    fn hexahedra_and_tetrahedra_of_a_cube() {
+        let cube = unit_cube();
+        let hex = |n: &[u32]| mesh(cube.clone(), vec![element(ElementKind::Hex, n)]);
+        assert_eq!(validate(&hex(&[0, 1, 2, 3, 4, 5, 6, 7])), Ok(()));
+        assert_eq!(
+            validate(&hex(&[4, 5, 6, 7, 0, 1, 2, 3])),
+            Ok(()),
+            "mirrored"
+        );
+        assert_eq!(
+            validate(&hex(&[0, 1, 2, 3, 4, 5, 7, 6])),
+            Err(Defect::Tangled { element: 0 })
+        );
+        // the cube's six tetrahedra are conforming; a seventh over them overlaps
+        let tets: Vec<Element> = HEX_TETS
+            .iter()
+            .map(|t| element(ElementKind::Tet, &t.map(|i| i as u32)))
+            .collect();
+        assert_eq!(validate(&mesh(cube.clone(), tets.clone())), Ok(()));
+        let mut more = tets;
+        more.push(element(ElementKind::Tet, &[0, 1, 3, 4]));
+        assert!(validate(&mesh(cube, more)).is_err());
+    }
+
+    #[test]
+    fn a_2d_mesh_off_its_plane_is_refused() {
+        let mut m = square(2);
+        m.nodes[4].z = 0.1;
+        assert_eq!(validate(&m), Err(Defect::OffPlane { node: 4 }));
+    }
+
+    #[test]
+    fn the_description_names_the_file_tags() {
+        let mut m = square(2);
+        m.elements.push(m.elements[1].clone());
+        let d = validate(&m).unwrap_err();
+        let line = d.describe(&m, &|e| 100 + e as u64, &|n| n as u64 + 1);
+        assert!(
+            line.starts_with("elements 101 and 108 (triangles at"),
+            "{line}"
+        );
+        assert!(!line.contains('\n'));
+    }
 }
