@@ -7,7 +7,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use peritherm::bench::plate;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{Explicit, Integrator};
+use peritherm::solve::explicit::{Explicit, ExplicitScheme, Integrator};
 
 fn explicit_step(c: &mut Criterion) {
     let scale: f64 = std::env::var("PERITHERM_BENCH_SCALE")
@@ -28,7 +28,7 @@ fn explicit_step(c: &mut Criterion) {
         g.throughput(Throughput::Elements(model.conductance.nnz() as u64));
         for (kernel, on) in [("csr", false), ("stencils", true)] {
             let mut theta = model.theta0.clone();
-            let mut st = Explicit::new(&model, Integrator::Euler);
+            let mut st = Explicit::new(&model, ExplicitScheme::Euler);
             if st.set_stencils(on) != on {
                 continue;
             }

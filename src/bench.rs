@@ -13,7 +13,7 @@ use crate::model::{Geometry, Model};
 use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::run::run_model;
-use crate::solve::explicit::Explicit;
+use crate::solve::explicit::{Explicit, ExplicitScheme};
 use crate::solve::implicit::ImplicitStats;
 use crate::solve::Integrator;
 use rayon::ThreadPool;
@@ -150,7 +150,7 @@ pub fn time_cases(out: &Path, mut say: impl FnMut(&str)) -> Result<Vec<CaseRow>>
         // what Explicit::new decides for this model (it builds the stencils again: a fraction
         // of a second against the run)
         let stencils = if case.integrator == Integrator::Euler {
-            let st = Explicit::new(&model, Integrator::Euler);
+            let st = Explicit::new(&model, ExplicitScheme::Euler);
             let csr = 12.0 * model.conductance.nnz() as f64;
             (st.stencil_bytes() > 0).then(|| st.stencil_bytes() as f64 / csr)
         } else {
@@ -310,7 +310,7 @@ pub fn time_step(
 ) -> (f64, f64, Option<usize>) {
     let dt = 0.5 * Integrator::Euler.stable_dt(model);
     let mut theta = model.theta0.clone();
-    let mut st = pool.install(|| Explicit::new(model, Integrator::Euler));
+    let mut st = pool.install(|| Explicit::new(model, ExplicitScheme::Euler));
     let used = pool.install(|| st.set_stencils(stencils));
     let mut steps = Vec::with_capacity(reps);
     let mut passes = Vec::new();

@@ -4,7 +4,7 @@
 
 use peritherm::case::Case;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use std::path::PathBuf;
 
 use crate::common::case::CaseToml;
@@ -57,7 +57,7 @@ fn node_at(model: &Model, x: f64, y: f64, z: f64) -> usize {
 
 fn run_steps(model: &Model, steps: usize, dt: f64) -> Vec<f64> {
     let mut theta = model.theta0.clone();
-    let mut st = Explicit::new(model, Integrator::Euler);
+    let mut st = Explicit::new(model, ExplicitScheme::Euler);
     for s in 0..steps {
         st.step(&mut theta, s as f64 * dt, dt);
     }
@@ -358,7 +358,7 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
     let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
     let mut theta = model.theta0.clone();
     let e0 = model.energy(&theta);
-    let mut st = Explicit::new(&model, Integrator::Euler);
+    let mut st = Explicit::new(&model, ExplicitScheme::Euler);
     let mut t = 0.0;
     while t < 3.4 {
         st.step(&mut theta, t, dt);

@@ -6,7 +6,7 @@ use crate::common::case::CaseToml;
 use crate::common::figures::Table;
 use peritherm::case::Case;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::solve::implicit::{Adaptive, Implicit, Options, Ordering, Scheme, Solver};
 use std::path::Path;
 
@@ -86,7 +86,7 @@ fn implicit(model: &Model, scheme: Scheme, dt: f64, t_end: f64, options: Options
 /// Body temperatures at `t_end` from an explicit RK4 run with step `dt`.
 fn rk4(model: &Model, dt: f64, t_end: f64) -> Vec<f64> {
     let mut theta = model.theta0.clone();
-    let mut st = Explicit::new(model, Integrator::Rk4);
+    let mut st = Explicit::new(model, ExplicitScheme::Rk4);
     st.run(&mut theta, 0.0, dt, &[t_end], |_, _, _, _| Ok(()), |_| {})
         .unwrap();
     theta.truncate(model.cloud.n_body);
@@ -482,7 +482,7 @@ fn adaptive(
 fn rk4_outputs(model: &Model, outputs: &[f64]) -> Vec<Vec<f64>> {
     let dt = choose_dt(model, Integrator::Rk4, None).unwrap() / 4.0;
     let mut theta = model.theta0.clone();
-    let mut st = Explicit::new(model, Integrator::Rk4);
+    let mut st = Explicit::new(model, ExplicitScheme::Rk4);
     let nb = model.cloud.n_body;
     let mut fields = Vec::new();
     st.run(

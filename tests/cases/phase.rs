@@ -9,7 +9,7 @@ use peritherm::analytic::{neumann_front, Reference};
 use peritherm::case::Case;
 use peritherm::model::Model;
 use peritherm::solve::enthalpy::Enthalpic;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use std::path::Path;
 
 /// The phase-change checks (docs/validation.md).
@@ -95,7 +95,7 @@ fn enthalpy_form_equals_the_linear_form_without_phase_change() {
         assert!((dt - dt_enth).abs() < 1e-12 * dt, "{dt} vs {dt_enth}");
         let mut a = linear.theta0.clone();
         let mut b = enth.theta0.clone();
-        let mut lin = Explicit::new(&linear, Integrator::Euler);
+        let mut lin = Explicit::new(&linear, ExplicitScheme::Euler);
         let mut ent = Enthalpic::new(&enth, Integrator::Euler).unwrap();
         for s in 0..400 {
             let t = s as f64 * dt;

@@ -16,7 +16,7 @@ use crate::common::case::CaseToml;
 use crate::common::tables::{errors_and_rates, rates, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::solve::implicit::{Implicit, Options, Scheme};
 use std::path::Path;
 
@@ -208,7 +208,7 @@ fn sphere_cools_as_the_series() {
             peritherm::case::ReferenceSource::Analytic(r) => r.clone(),
             _ => unreachable!(),
         };
-        let mut st = Explicit::new(&model, Integrator::Euler);
+        let mut st = Explicit::new(&model, ExplicitScheme::Euler);
         let mut theta = model.theta0.clone();
         let nb = model.cloud.n_body;
         let mut row = Vec::new();
@@ -271,7 +271,7 @@ fn insulated_axisymmetric_body_conserves_energy() {
         let dt = choose_dt(&model, integ, None).unwrap();
         let mut theta = model.theta0.clone();
         let e0 = model.energy(&theta);
-        let mut st = Explicit::new(&model, integ);
+        let mut st = Explicit::new(&model, integ.try_into().unwrap());
         for s in 0..500 {
             st.step(&mut theta, s as f64 * dt, dt);
         }

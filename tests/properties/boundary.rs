@@ -3,7 +3,7 @@
 
 use crate::common::case::CaseToml;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{Explicit, Integrator};
+use peritherm::solve::explicit::{Explicit, ExplicitScheme};
 
 /// A 2D plate 1 × 0.5 (thickness 0.1) with the given boundary tables and initial field.
 fn plate(placement: &str, faces: &str, initial: &str) -> Model {
@@ -152,7 +152,7 @@ value = 7.0
     let mut theta = m.theta0.clone();
     let e0 = m.energy(&theta);
     let dt = 1e-4;
-    Explicit::new(&m, Integrator::Euler).step(&mut theta, 0.0, dt);
+    Explicit::new(&m, ExplicitScheme::Euler).step(&mut theta, 0.0, dt);
     let area = 1.0 * 0.1; // face length × thickness
     let volume = 1.0 * 0.5 * 0.1;
     let expected = dt * (10.0 * area * (30.0 - 20.0) + 7.0 * volume);

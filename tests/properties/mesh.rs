@@ -11,7 +11,7 @@ use peritherm::cloud::{Cloud, HorizonRule};
 use peritherm::gmsh;
 use peritherm::model::Model;
 use peritherm::neighbors::Horizons;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -115,7 +115,7 @@ fn nodes_follow_a_space_filling_curve() {
 
 fn run_steps(model: &Model, steps: usize, dt: f64) -> Vec<f64> {
     let mut theta = model.theta0.clone();
-    let mut st = Explicit::new(model, Integrator::Euler);
+    let mut st = Explicit::new(model, ExplicitScheme::Euler);
     let mut t = 0.0;
     for _ in 0..steps {
         st.step(&mut theta, t, dt);

@@ -5,7 +5,7 @@
 use crate::common::case::CaseToml;
 use peritherm::case::Case;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::weights::Order;
 
 /// A two-region dual-horizon plate 2 × 1: k = Δ1/Δ2 = 0.5, m = δ1/δ2 = 2/3 (so neither
@@ -38,7 +38,7 @@ fn energy_is_conserved_with_dual_horizon() {
         let dt = choose_dt(&model, integ, None).unwrap() / 20.0;
         let mut theta = model.theta0.clone();
         let e0 = model.energy(&theta);
-        let mut st = Explicit::new(&model, integ);
+        let mut st = Explicit::new(&model, integ.try_into().unwrap());
         for s in 0..1000 {
             st.step(&mut theta, s as f64 * dt, dt);
         }
@@ -380,7 +380,7 @@ fn explicit_runs_agree_serial_and_parallel() {
                 .unwrap();
             pool.install(|| {
                 let mut theta = model.theta0.clone();
-                let mut st = Explicit::new(&model, integ);
+                let mut st = Explicit::new(&model, integ.try_into().unwrap());
                 let used = st.set_stencils(stencils);
                 assert!(!used || stencils);
                 for s in 0..steps {
@@ -392,7 +392,7 @@ fn explicit_runs_agree_serial_and_parallel() {
         let one = run(1, false);
         assert_eq!(one, run(2, false), "{integ:?}: 1 and 2 threads differ");
         if integ == Integrator::Euler {
-            let mut st = Explicit::new(&model, integ);
+            let mut st = Explicit::new(&model, integ.try_into().unwrap());
             stencils_seen |= st.set_stencils(true);
             assert!(
                 !lattice || st.set_stencils(true),
@@ -513,7 +513,7 @@ fn time_step_bound() {
     );
     let amplitude = |dt: f64| {
         let mut theta = model.theta0.clone();
-        let mut st = Explicit::new(&model, Integrator::Euler);
+        let mut st = Explicit::new(&model, ExplicitScheme::Euler);
         for s in 0..400 {
             st.step(&mut theta, s as f64 * dt, dt);
         }
@@ -578,7 +578,7 @@ fn linear_consistency_correction_is_exact_and_conservative() {
     let dt = choose_dt(&m, Integrator::Euler, None).unwrap() / 20.0;
     let mut theta = m.theta0.clone();
     let e0 = m.energy(&theta);
-    let mut st = Explicit::new(&m, Integrator::Euler);
+    let mut st = Explicit::new(&m, ExplicitScheme::Euler);
     for s in 0..1000 {
         st.step(&mut theta, s as f64 * dt, dt);
     }
@@ -610,7 +610,7 @@ fn three_dimensional_boxes_conserve_energy() {
     let dt = choose_dt(&m, Integrator::Rk4, None).unwrap() / 10.0;
     let mut theta = m.theta0.clone();
     let e0 = m.energy(&theta);
-    let mut st = Explicit::new(&m, Integrator::Rk4);
+    let mut st = Explicit::new(&m, ExplicitScheme::Rk4);
     for s in 0..200 {
         st.step(&mut theta, s as f64 * dt, dt);
     }

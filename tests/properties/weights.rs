@@ -6,7 +6,7 @@
 use crate::common::case::CaseToml;
 use crate::common::figures::Table;
 use peritherm::model::Model;
-use peritherm::solve::explicit::{choose_dt, Explicit, Integrator};
+use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::weights::{self, Order};
 use std::path::{Path, PathBuf};
 
@@ -149,7 +149,7 @@ fn consistent_weights_are_symmetric_positive_stable_and_conservative() {
         let top = theta.iter().cloned().fold(f64::MIN, f64::max);
         let bottom = theta.iter().cloned().fold(f64::MAX, f64::min);
         let e0 = m.energy(&theta);
-        let mut st = Explicit::new(&m, Integrator::Euler);
+        let mut st = Explicit::new(&m, ExplicitScheme::Euler);
         for s in 0..10_000 {
             st.step(&mut theta, s as f64 * dt, dt);
         }

@@ -8,7 +8,7 @@ use crate::operator::Conductance;
 use crate::solve::enthalpy::Enthalpic;
 use crate::solve::explicit::Explicit;
 use crate::solve::implicit::{self, Adaptive, Implicit, Solver};
-use crate::solve::integrator::Integrator;
+use crate::solve::integrator::{Integrator, Stepping};
 use crate::solve::stepper::{march, RunStats, Stepper};
 
 /// The stepper of a case: the one that its integrator and model call for.
@@ -31,8 +31,11 @@ impl<'a> Engine<'a> {
         if model.enthalpy.is_some() {
             return Ok(Engine::Enthalpic(Enthalpic::new(model, integrator)?));
         }
-        let Some(scheme) = integrator.scheme() else {
-            return Ok(Engine::Explicit(Explicit::new(model, integrator)));
+        let scheme = match integrator.stepping() {
+            Stepping::Explicit(explicit) => {
+                return Ok(Engine::Explicit(Explicit::new(model, explicit)))
+            }
+            Stepping::Implicit(scheme) => scheme,
         };
         let options = implicit::Options {
             solver: if adaptive {

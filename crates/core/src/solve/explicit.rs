@@ -15,7 +15,9 @@ use std::borrow::Cow;
 use std::ops::Range;
 
 // the integrator and the stepping interface under their old paths
-pub use crate::solve::integrator::{choose_dt, count_steps, steps_between, Integrator};
+pub use crate::solve::integrator::{
+    choose_dt, count_steps, steps_between, ExplicitScheme, Integrator,
+};
 use crate::solve::stepper::first_non_finite;
 pub use crate::solve::stepper::{check_finite, RunStats};
 use crate::solve::stepper::{march, Stepper};
@@ -130,7 +132,7 @@ pub struct Explicit<'a> {
     conductance: Cow<'a, Conductance>,
     /// Index of the next growing-crack cut in `model.growth`.
     next_cut: usize,
-    integrator: Integrator,
+    integrator: ExplicitScheme,
     k: [Vec<f64>; 4],
     stage: Vec<f64>,
     /// K as shared stencils for the Euler step (lattice clouds without growing cracks).
@@ -143,11 +145,11 @@ pub struct Explicit<'a> {
 
 impl<'a> Explicit<'a> {
     /// Allocates the buffers for a model.
-    pub fn new(model: &'a Model, integrator: Integrator) -> Self {
+    pub fn new(model: &'a Model, integrator: ExplicitScheme) -> Self {
         let nb = model.cloud.n_body;
         let stages = match integrator {
-            Integrator::Rk4 => 4,
-            _ => 1,
+            ExplicitScheme::Rk4 => 4,
+            ExplicitScheme::Euler => 1,
         };
         let k = std::array::from_fn(|s| {
             if s < stages {
@@ -169,7 +171,9 @@ impl<'a> Explicit<'a> {
             k,
             stage: vec![0.0; model.cloud.len()],
             stencils: match integrator {
-                Integrator::Euler if model.growth.is_empty() => Stencils::build(&model.conductance),
+                ExplicitScheme::Euler if model.growth.is_empty() => {
+                    Stencils::build(&model.conductance)
+                }
                 _ => None,
             },
             rows: 0..nb,
@@ -194,7 +198,7 @@ impl<'a> Explicit<'a> {
             (false, _) => None,
             (true, Some(s)) => Some(s),
             (true, None)
-                if self.integrator == Integrator::Euler && self.model.growth.is_empty() =>
+                if self.integrator == ExplicitScheme::Euler && self.model.growth.is_empty() =>
             {
                 Stencils::build(&self.model.conductance)
             }
@@ -229,10 +233,6 @@ impl<'a> Explicit<'a> {
 
     /// Advances `theta` (all nodes) from t to t + h, constraints included; growing cracks
     /// cut the bonds their tips have passed by t first.
-    ///
-    /// # Panics
-    /// If built with an implicit integrator (those run through [`crate::solve::implicit`];
-    /// `run_case` dispatches them there).
     pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
         self.cut_until(t);
         let m = self.model;
@@ -244,19 +244,13 @@ impl<'a> Explicit<'a> {
             Cow::Owned(_) => None,
         };
         match self.integrator {
-            Integrator::BackwardEuler
-            | Integrator::CrankNicolson
-            | Integrator::Bdf2
-            | Integrator::Steady => {
-                panic!("implicit integrators run through solve::implicit, not Explicit")
-            }
-            Integrator::Euler if m.boundary.has_loads() => {
+            ExplicitScheme::Euler if m.boundary.has_loads() => {
                 rates_with(m, k, st, theta, t, rows.clone(), &mut self.k[0]);
                 update(&mut theta[rows.clone()], &self.k[0][rows], |y, r| {
                     *y += h * r
                 });
             }
-            Integrator::Euler => {
+            ExplicitScheme::Euler => {
                 // the new body temperatures into k[0], then back into θ (the caller's slice)
                 euler_fused(
                     m,
@@ -269,7 +263,7 @@ impl<'a> Explicit<'a> {
                 );
                 update(&mut theta[rows.clone()], &self.k[0][rows], |y, n| *y = n);
             }
-            Integrator::Rk4 => self.rk4(theta, t, h),
+            ExplicitScheme::Rk4 => self.rk4(theta, t, h),
         }
         constrain(m, self.exchange, theta, t + h);
     }

@@ -26,6 +26,44 @@ pub enum Integrator {
     Steady,
 }
 
+/// An explicit integrator, the ones [`crate::solve::explicit::Explicit`] steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExplicitScheme {
+    /// Forward Euler.
+    Euler,
+    /// Classical fourth-order Runge–Kutta.
+    Rk4,
+}
+
+/// How an integrator steps ([`Integrator::stepping`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stepping {
+    /// By [`crate::solve::explicit::Explicit`].
+    Explicit(ExplicitScheme),
+    /// By [`crate::solve::implicit::Implicit`] with this scheme.
+    Implicit(Scheme),
+}
+
+impl TryFrom<Integrator> for ExplicitScheme {
+    /// The implicit scheme of an integrator that is not explicit.
+    type Error = Scheme;
+    fn try_from(i: Integrator) -> std::result::Result<ExplicitScheme, Scheme> {
+        match i.stepping() {
+            Stepping::Explicit(e) => Ok(e),
+            Stepping::Implicit(s) => Err(s),
+        }
+    }
+}
+
+impl From<ExplicitScheme> for Integrator {
+    fn from(s: ExplicitScheme) -> Integrator {
+        match s {
+            ExplicitScheme::Euler => Integrator::Euler,
+            ExplicitScheme::Rk4 => Integrator::Rk4,
+        }
+    }
+}
+
 impl Integrator {
     /// Every integrator, in the order their names are listed to users.
     pub const ALL: [Integrator; 6] = [
@@ -59,15 +97,24 @@ impl Integrator {
         !matches!(self, Integrator::Euler | Integrator::Rk4)
     }
 
+    /// How the integrator steps: its explicit scheme, or the implicit scheme it runs.
+    pub fn stepping(&self) -> Stepping {
+        match self {
+            Integrator::Euler => Stepping::Explicit(ExplicitScheme::Euler),
+            Integrator::Rk4 => Stepping::Explicit(ExplicitScheme::Rk4),
+            Integrator::BackwardEuler => Stepping::Implicit(Scheme::BackwardEuler),
+            Integrator::CrankNicolson => Stepping::Implicit(Scheme::CrankNicolson),
+            Integrator::Bdf2 | Integrator::Steady => Stepping::Implicit(Scheme::Bdf2),
+        }
+    }
+
     /// The implicit scheme that runs this integrator (the steady solve uses the system and
     /// solvers of BDF2's set-up); None for the explicit integrators. The one place the
     /// implicit [`Scheme`] is derived from the integrator.
     pub fn scheme(&self) -> Option<Scheme> {
-        match self {
-            Integrator::BackwardEuler => Some(Scheme::BackwardEuler),
-            Integrator::CrankNicolson => Some(Scheme::CrankNicolson),
-            Integrator::Bdf2 | Integrator::Steady => Some(Scheme::Bdf2),
-            Integrator::Euler | Integrator::Rk4 => None,
+        match self.stepping() {
+            Stepping::Implicit(scheme) => Some(scheme),
+            Stepping::Explicit(_) => None,
         }
     }
 
