@@ -143,6 +143,15 @@ pub struct Explicit<'a> {
     exchange: Option<&'a dyn Exchange>,
 }
 
+/// The stencils of K for `scheme` on `model`: built for Euler without growing cracks, when
+/// the cloud repeats rows (lattices); None otherwise.
+fn stencils_for(model: &Model, scheme: ExplicitScheme) -> Option<Stencils> {
+    match scheme {
+        ExplicitScheme::Euler if model.growth.is_empty() => Stencils::build(&model.conductance),
+        _ => None,
+    }
+}
+
 impl<'a> Explicit<'a> {
     /// Allocates the buffers for a model.
     pub fn new(model: &'a Model, integrator: ExplicitScheme) -> Self {
@@ -170,12 +179,7 @@ impl<'a> Explicit<'a> {
             integrator,
             k,
             stage: vec![0.0; model.cloud.len()],
-            stencils: match integrator {
-                ExplicitScheme::Euler if model.growth.is_empty() => {
-                    Stencils::build(&model.conductance)
-                }
-                _ => None,
-            },
+            stencils: stencils_for(model, integrator),
             rows: 0..nb,
             exchange: None,
         }
@@ -197,12 +201,7 @@ impl<'a> Explicit<'a> {
         self.stencils = match (on, self.stencils.take()) {
             (false, _) => None,
             (true, Some(s)) => Some(s),
-            (true, None)
-                if self.integrator == ExplicitScheme::Euler && self.model.growth.is_empty() =>
-            {
-                Stencils::build(&self.model.conductance)
-            }
-            (true, None) => None,
+            (true, None) => stencils_for(self.model, self.integrator),
         };
         self.stencils.is_some()
     }

@@ -55,15 +55,6 @@ impl TryFrom<Integrator> for ExplicitScheme {
     }
 }
 
-impl From<ExplicitScheme> for Integrator {
-    fn from(s: ExplicitScheme) -> Integrator {
-        match s {
-            ExplicitScheme::Euler => Integrator::Euler,
-            ExplicitScheme::Rk4 => Integrator::Rk4,
-        }
-    }
-}
-
 impl Integrator {
     /// Every integrator, in the order their names are listed to users.
     pub const ALL: [Integrator; 6] = [
@@ -94,7 +85,7 @@ impl Integrator {
 
     /// True for the implicit schemes and the steady solve ([`crate::solve::implicit`]).
     pub fn is_implicit(&self) -> bool {
-        !matches!(self, Integrator::Euler | Integrator::Rk4)
+        matches!(self.stepping(), Stepping::Implicit(_))
     }
 
     /// How the integrator steps: its explicit scheme, or the implicit scheme it runs.
