@@ -1,7 +1,7 @@
 //! The layering of the code: within every crate of the workspace, no module imports one that
 //! imports it back, directly or through others. Imports are read as text (`crate::a::b` and
-//! `super::b` paths outside comments and test modules), which is enough for this code base:
-//! it writes every import as a full path.
+//! `super::b` paths outside comments and test modules; a module also reaches its submodules),
+//! which is enough for this code base: it writes every import as a full path.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -72,6 +72,14 @@ fn imports(src: &Path) -> BTreeMap<Vec<String>, BTreeSet<Vec<String>>> {
             }
         }
         graph.insert(module.clone(), targets);
+    }
+    // a module holds its submodules: what they import, it imports
+    let children: Vec<Vec<String>> = graph.keys().filter(|m| !m.is_empty()).cloned().collect();
+    for child in children {
+        let parent = child[..child.len() - 1].to_vec();
+        if let Some(targets) = graph.get_mut(&parent) {
+            targets.insert(child);
+        }
     }
     graph
 }

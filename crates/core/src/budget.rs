@@ -10,6 +10,7 @@ use crate::limits::{
     IMPLICIT_BOND_FACTOR, MAX_DIRECT_ENTRIES, MAX_NEIGHBOURS, MEMORY_FRACTION,
     SHARED_BYTES_PER_NODE,
 };
+pub use crate::machine::Memory;
 use crate::model::{Geometry, ModelSpec};
 use crate::weights::Order;
 use serde::Serialize;
@@ -27,38 +28,6 @@ pub struct Estimate {
     pub bytes: f64,
     /// The case key whose value sets most of the size (e.g. `region[0].spacing`).
     pub key: String,
-}
-
-/// The machine's memory from `/proc/meminfo`, bytes (None where it cannot be read).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Memory {
-    /// `MemAvailable`, bytes.
-    pub available: Option<f64>,
-    /// `MemTotal`, bytes.
-    pub total: Option<f64>,
-}
-
-impl Memory {
-    /// Reads `/proc/meminfo` (Linux); elsewhere both are None.
-    pub fn of_machine() -> Memory {
-        let text = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
-        let field = |name: &str| {
-            text.lines()
-                .find_map(|l| l.strip_prefix(name))
-                .and_then(|rest| {
-                    rest.trim()
-                        .trim_end_matches("kB")
-                        .trim()
-                        .parse::<f64>()
-                        .ok()
-                })
-                .map(|kb| kb * 1024.0)
-        };
-        Memory {
-            available: field("MemAvailable:"),
-            total: field("MemTotal:"),
-        }
-    }
 }
 
 /// Formats bytes with a binary prefix, e.g. `1.5 GiB`.

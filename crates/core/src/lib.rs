@@ -18,6 +18,7 @@ pub mod error;
 pub mod expr;
 pub mod kernel;
 pub mod limits;
+pub mod machine;
 pub mod material;
 pub mod math;
 pub mod mesh;

@@ -15,12 +15,11 @@ use std::borrow::Cow;
 use std::ops::Range;
 
 // the integrator and the stepping interface under their old paths
-pub use crate::solve::integrator::{
-    choose_dt, count_steps, steps_between, ExplicitScheme, Integrator,
-};
+pub use crate::solve::integrator::{choose_dt, ExplicitScheme, Integrator};
 use crate::solve::stepper::first_non_finite;
 pub use crate::solve::stepper::{check_finite, RunStats};
 use crate::solve::stepper::{march, Stepper};
+pub use crate::solve::steps::{count_steps, steps_between};
 
 fn rates(
     model: &Model,

@@ -9,7 +9,9 @@ pub mod explicit;
 pub mod implicit;
 pub mod integrator;
 pub mod stepper;
+pub mod steps;
 
 pub use engine::{integrate, Engine, Schedule};
-pub use integrator::{choose_dt, count_steps, steps_between, Integrator};
+pub use integrator::{choose_dt, Integrator};
 pub use stepper::{check_finite, march, RunStats, Stepper};
+pub use steps::{count_steps, steps_between};

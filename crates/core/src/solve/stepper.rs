@@ -7,7 +7,7 @@
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::operator::Conductance;
-use crate::solve::integrator::steps_between;
+use crate::solve::steps::steps_between;
 
 /// Summary of a run.
 #[derive(Debug, Clone, Copy, Default)]

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 /// Largest number of stored entries of H's lower triangle solved directly (beyond it, or in
 /// 3D where the fill of a horizon of ~100 neighbours grows too fast: CG with the two-level
 /// preconditioner, which on large 2D meshes needs thousands of iterations per Newton step).
-/// The set-up's memory estimate counts the factor ([`crate::budget::estimate`]).
+/// The set-up's memory estimate (the budget module) counts the factor.
 const MAX_ENTRIES: usize = crate::limits::MAX_DIRECT_ENTRIES as usize;
 
 /// Fraction of the machine's available memory (read when the structure is analysed) that the
@@ -27,7 +27,7 @@ const FACTOR_MEMORY_FRACTION: f64 = 0.9;
 /// [`FACTOR_MEMORY_FRACTION`] of the machine's available memory now, bytes (None where it
 /// cannot be read).
 pub(super) fn machine_room() -> Option<f64> {
-    let available = crate::budget::Memory::of_machine().available;
+    let available = crate::machine::Memory::of_machine().available;
     available.map(|a| a * FACTOR_MEMORY_FRACTION)
 }
 
