@@ -10,7 +10,7 @@ use crate::limits::{
     IMPLICIT_BOND_FACTOR, MAX_DIRECT_ENTRIES, MAX_NEIGHBOURS, MEMORY_FRACTION,
     SHARED_BYTES_PER_NODE,
 };
-pub use crate::machine::Memory;
+use crate::machine::Memory;
 use crate::model::{Geometry, ModelSpec};
 use crate::weights::Order;
 use serde::Serialize;
