@@ -136,19 +136,23 @@ struct Problem<'a> {
 /// φ(ξ) scaled by the node's horizon s: (ξ/s, vech(ξξᵀ)/s²), masked to the used components.
 #[inline(always)]
 fn phi(xi: &Vector, s: Real, used: &Mom) -> Mom {
-    let a = xi / s;
+    monomials(&(xi / s)).component_mul(used)
+}
+
+/// The monomials q(ξ) = (ξ, vech ξξᵀ) of a bond, unscaled and unmasked (φ is q scaled).
+#[inline(always)]
+fn monomials(x: &Vector) -> Mom {
     Mom::from([
-        a.x,
-        a.y,
-        a.z,
-        a.x * a.x,
-        a.y * a.y,
-        a.z * a.z,
-        a.x * a.y,
-        a.x * a.z,
-        a.y * a.z,
+        x.x,
+        x.y,
+        x.z,
+        x.x * x.x,
+        x.y * x.y,
+        x.z * x.z,
+        x.x * x.y,
+        x.x * x.z,
+        x.y * x.z,
     ])
-    .component_mul(used)
 }
 
 /// The moment components in use for `dim` and `order`.
@@ -399,23 +403,48 @@ impl<'a> Problem<'a> {
             .reduce(|| 0.0, Real::max)
     }
 
-    /// y = H v, the Hessian of D: (H v)_i = Σ_j K'_ij φ_i (φ_i·v_i + φ_j·v_j).
-    fn hessian(&self, vals: &[Real], v: &[Mom], y: &mut [Mom]) {
+    /// y = H v, the Hessian of D: (H v)_i = Σ_j K'_ij φ_i (φ_i·v_i + φ_j·v_j), with `bare`
+    /// scratch of one moment vector per body node.
+    ///
+    /// φ_i(ξ) is the monomial vector q(ξ) = (ξ, vech ξξᵀ) scaled by node i's horizon, and
+    /// φ_j(ξ_ji) is q(−ξ) scaled by node j's, so the scales move onto the nodes: v_j / scale_j
+    /// once per node (`bare`), then per pair only q(ξ), two dot products and one update.
+    fn hessian(&self, vals: &[Real], v: &[Mom], bare: &mut [Mom], y: &mut [Mom]) {
+        let c = self.cloud;
+        bare.par_iter_mut().enumerate().for_each(|(j, b)| {
+            *b = match self.lam(v, j) {
+                Some(vj) => self.unscaled(vj, c.horizon[j]),
+                None => Mom::zeros(),
+            };
+        });
+        let bare = &*bare;
         y.par_iter_mut().enumerate().for_each(|(i, yi)| {
             *yi = Mom::zeros();
             if !self.sel[i] {
                 return;
             }
+            let mut acc = Mom::zeros();
             for e in self.offsets[i]..self.offsets[i + 1] {
                 let j = self.cols[e] as usize;
-                let (pi, pj) = self.phis(i, j);
-                let mut s = pi.dot(&v[i]);
-                if let Some(vj) = self.lam(v, j) {
-                    s += pj.dot(vj);
+                let q = monomials(&(c.pos[j] - c.pos[i]));
+                let mut s = q.dot(&bare[i]);
+                if j < self.n() {
+                    let bj = &bare[j];
+                    s += q.fixed_rows::<6>(3).dot(&bj.fixed_rows::<6>(3))
+                        - q.fixed_rows::<3>(0).dot(&bj.fixed_rows::<3>(0));
                 }
-                *yi += (vals[e] * s) * pi;
+                acc += (vals[e] * s) * q;
             }
+            *yi = self.unscaled(&acc, c.horizon[i]);
         });
+    }
+
+    /// `m` with its first-moment part divided by `s` and its second-moment part by s²,
+    /// masked to the used components: φ(ξ, s)·v = q(ξ)·unscaled(v, s).
+    #[inline(always)]
+    fn unscaled(&self, m: &Mom, s: Real) -> Mom {
+        let (a, b) = (1.0 / s, 1.0 / (s * s));
+        Mom::from_fn(|k, _| m[k] * if k < 3 { a } else { b }).component_mul(&self.used)
     }
 
     /// Inverse diagonal blocks of H (identity on unused components and unselected nodes).
@@ -513,10 +542,11 @@ fn solve(
     precondition(&r, &mut z, pre);
     let mut d = z.clone();
     let mut hd = vec![Mom::zeros(); b.len()];
+    let mut bare = vec![Mom::zeros(); b.len()];
     let mut rz = dot(&r, &z);
     let mut it = 0;
     while it < cap && dot(&r, &r).sqrt() > rel * norm_b {
-        p.hessian(vals, &d, &mut hd);
+        p.hessian(vals, &d, &mut bare, &mut hd);
         let dhd = dot(&d, &hd);
         if dhd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             break;
