@@ -37,9 +37,9 @@ type NodeModes = SMatrix<Real, { super::NC }, MAX_MODES>;
 /// of 4 594 tetrahedral nodes: 280 against 474 CG iterations) the assembly of the larger
 /// coarse matrix cost more than the iterations saved (8.1 against 6.2 s).
 fn modes(dim: usize) -> usize {
+    // 1D: 1 + 1 + 1; 2D: 2 + 3 + 1 affine and 6 quadratic; 3D: 3 + 6 + 3 affine
     match dim {
         1 => 3,
-        2 => 12,
         _ => 12,
     }
 }

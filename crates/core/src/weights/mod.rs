@@ -487,7 +487,6 @@ fn dot(a: &[Mom], b: &[Mom]) -> Real {
     crate::math::ordered_sum(a.len(), |i| a[i].dot(&b[i]))
 }
 
-/// Solves H x = b by block-Jacobi preconditioned CG to `rel` of |b|; returns the iterations.
 /// The preconditioner of the Newton systems.
 enum Precond<'a> {
     /// A Cholesky factor of H at earlier weights.
