@@ -707,22 +707,19 @@ fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyho
     use peritherm::solve::Integrator;
     let case = Case::load(path)?;
     say!("{}: {}", case.path.display(), case.budget.line());
-    let started = std::time::Instant::now();
     let setup = SetupBar::new(false);
-    let model = peritherm::prepare::build(&case, options)?;
+    let model = peritherm::prepare::build_for_check(&case, options)?;
     drop(setup);
+    let pending =
+        model.correction.is_none() && peritherm::model::corrects(&case.spec, &model.cloud);
     if let Some(c) = &model.correction {
         say!(
-            "{}: consistent weights at {} nodes {} in {:.2} s",
+            "{}: consistent weights at {} nodes loaded from the weights cache",
             case.path.display(),
-            c.corrected,
-            if c.reused {
-                "loaded from the weights cache"
-            } else {
-                "solved"
-            },
-            started.elapsed().as_secs_f64()
+            c.corrected
         );
+    } else if pending {
+        say!("{}", weights_estimate(&case, &model));
     }
     let plan = peritherm::prepare::plan(&case, &model)?;
     let sizes = format!(
@@ -753,6 +750,37 @@ fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyho
         ),
     }
     Ok(())
+}
+
+/// The line of `check` for consistent weights it did not solve: the estimated set-up.
+fn weights_estimate(case: &Case, model: &peritherm::model::Model) -> String {
+    use peritherm::weights::{estimate, Path};
+    let order = case.spec.consistency;
+    let (nodes, pairs) = (model.cloud.n_body, model.conductance.vals.len());
+    let e = estimate(model.cloud.dim, order, nodes, pairs);
+    let how = match e.path {
+        Path::Direct => format!(
+            "one sparse factor of about {}",
+            peritherm::budget::human(e.bytes)
+        ),
+        Path::TwoLevel => "two-level CG".to_string(),
+    };
+    format!(
+        "{}: consistent weights not in the weights cache: `run` will solve them for up to {nodes} nodes and {pairs} pairs ({how}), estimated {} on 2 threads; the stable dt below is that of K before them",
+        case.path.display(),
+        human_seconds(e.seconds)
+    )
+}
+
+/// Seconds as a short duration (s, min or h).
+fn human_seconds(s: f64) -> String {
+    if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
 }
 
 /// Prints a run's comparison with its reference, one line per output time.

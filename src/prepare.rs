@@ -7,7 +7,7 @@ use crate::case::Case;
 use crate::cloud::FACE_NAMES;
 use crate::error::{Error, Result};
 use crate::limits::MAX_STEPS;
-use crate::model::{Geometry, Model};
+use crate::model::{Geometry, Model, Weights};
 use crate::solve::exchange::{Collective, RankPlan, Reduce};
 use crate::solve::implicit::{symmetric_over, Adaptive};
 use crate::solve::{choose_dt, count_steps, Engine, Integrator, Schedule};
@@ -73,15 +73,27 @@ pub fn build(case: &Case, options: &Options) -> Result<Model> {
     build_keeping(case, options, true)
 }
 
+/// [`build`] as `peritherm check` does it: consistent weights are loaded from the cache when
+/// it holds them and otherwise not solved (K stays uncorrected, the model's correction is
+/// None), so that a check answers in the time of a set-up without them.
+pub fn build_for_check(case: &Case, options: &Options) -> Result<Model> {
+    build_as(case, options, true, Weights::StoredOnly)
+}
+
 /// [`build`], keeping newly computed weights in the cache only when `writes`.
 fn build_keeping(case: &Case, options: &Options, writes: bool) -> Result<Model> {
+    build_as(case, options, writes, Weights::Solve)
+}
+
+/// [`build`], keeping new weights only when `writes`, solving them as `weights` says.
+fn build_as(case: &Case, options: &Options, writes: bool, weights: Weights) -> Result<Model> {
     case.budget
         .enforce(options.max_memory)
         .map_err(|message| case.error(&case.budget.key, message))?;
     let store = options.store(writes);
     let store = store.as_ref().map(|s| s as &dyn Store);
     // the semantic checks run before the consistent weights are solved
-    Model::build_checked(&case.spec, store, |model| semantic(case, model))
+    Model::build_checked_as(&case.spec, (store, weights), |model| semantic(case, model))
         .map_err(|e| keyed(case, e))
 }
 

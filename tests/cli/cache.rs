@@ -219,9 +219,10 @@ fn a_damaged_cache_file_is_recomputed_not_trusted() {
     }
 }
 
-/// `check` solves the weights once and says so; the next `check` (or run) loads them.
+/// `check` does not solve the weights (it estimates them and leaves the cache empty); after a
+/// run has solved them, `check` loads them.
 #[test]
-fn check_keeps_the_weights_for_the_next_command() {
+fn check_estimates_the_weights_and_loads_what_a_run_kept() {
     let s = Setting::new();
     let check = || {
         let o = command()
@@ -234,7 +235,19 @@ fn check_keeps_the_weights_for_the_next_command() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         String::from_utf8(o.stdout).unwrap()
     };
-    assert!(check().contains("consistent weights at 1868 nodes solved"));
-    assert!(check().contains("consistent weights at 1868 nodes loaded from the weights cache"));
+    let first = check();
+    assert!(
+        first.contains("consistent weights not in the weights cache"),
+        "{first}"
+    );
+    assert!(first.contains("estimated"), "{first}");
+    let kept = std::fs::read_dir(s.cache()).map_or(0, |d| d.count());
+    assert_eq!(kept, 0, "check kept nothing in the cache");
+    assert!(!reused(&s.run("first", true, &[])), "the first run solves");
+    let second = check();
+    assert!(
+        second.contains("consistent weights at 1868 nodes loaded from the weights cache"),
+        "{second}"
+    );
     assert!(reused(&s.run("after", true, &[])), "the run after check");
 }

@@ -16,7 +16,7 @@ use crate::operator::{directed_weights, Conductance};
 use crate::partition::Partition;
 use crate::symmetry::Symmetry;
 use crate::weights::store::Store;
-use crate::weights::{correct_reusing, Consistency, Order};
+use crate::weights::{correct_reusing, correct_stored, Consistency, Order};
 use std::ops::Range;
 
 /// Initial temperature field.
@@ -397,7 +397,7 @@ impl Bonds {
             (cloud, horizons, layered, mu),
             bond_conductivity,
             &mut conductance,
-            store,
+            (store, Weights::Solve),
         );
         let growth = pair_cuts(cloud, horizons, &conductance, &cuts.later);
         Bonds {
@@ -428,7 +428,7 @@ impl Bonds {
 }
 
 /// Whether `spec` asks for consistent weights where they apply (not on a symmetric cloud).
-fn corrects(spec: &ModelSpec, cloud: &Cloud) -> bool {
+pub fn corrects(spec: &ModelSpec, cloud: &Cloud) -> bool {
     spec.consistency != Order::None && !cloud.symmetry.is_symmetric()
 }
 
@@ -440,21 +440,33 @@ fn correction_of(
     (cloud, horizons, layered, mu): (&Cloud, &Horizons, &[bool], &[f64]),
     bond_conductivity: &[f64],
     conductance: &mut Conductance,
-    store: Option<&dyn Store>,
+    (store, weights): (Option<&dyn Store>, Weights),
 ) -> (Option<Consistency>, Vec<bool>) {
     if !corrects(spec, cloud) {
         return (None, vec![false; cloud.n_body]);
     }
     let sel = complete_horizons(cloud, horizons, layered, mu);
-    let (c, met) = correct_reusing(
-        conductance,
-        cloud,
-        &sel,
-        bond_conductivity,
-        spec.consistency,
-        store,
-    );
+    let order = spec.consistency;
+    if weights == Weights::StoredOnly {
+        let stored = store
+            .and_then(|s| correct_stored(conductance, cloud, &sel, bond_conductivity, order, s));
+        return match stored {
+            Some((c, met)) => (Some(c), met),
+            None => (None, vec![false; cloud.n_body]),
+        };
+    }
+    let (c, met) = correct_reusing(conductance, cloud, &sel, bond_conductivity, order, store);
     (Some(c), met)
+}
+
+/// Whether a build solves the consistent weights it asks for, or only loads stored ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weights {
+    /// Load them from the store if it holds them, else solve them (and keep them there).
+    Solve,
+    /// Load them from the store if it holds them, else leave K as it is (`peritherm check`,
+    /// which estimates the set-up instead: [`crate::weights::estimate`]).
+    StoredOnly,
 }
 
 /// The enthalpy curves of a phase-change model with the conductivity and capacity bounds
@@ -554,6 +566,17 @@ impl Model {
         store: Option<&dyn Store>,
         check: impl Fn(&Model) -> Result<()>,
     ) -> Result<Model> {
+        Self::build_checked_as(spec, (store, Weights::Solve), check)
+    }
+
+    /// [`Model::build_checked`], solving the consistent weights or only loading stored ones
+    /// (`weights`); with [`Weights::StoredOnly`] and nothing stored, K stays uncorrected and
+    /// [`Model::correction`] is None.
+    pub fn build_checked_as(
+        spec: &ModelSpec,
+        (store, weights): (Option<&dyn Store>, Weights),
+        check: impl Fn(&Model) -> Result<()>,
+    ) -> Result<Model> {
         let bare = ModelSpec {
             consistency: Order::None,
             ..spec.clone()
@@ -564,7 +587,7 @@ impl Model {
         let mut model = Self::finish(&bare, cloud, horizons, phase, &layered, rows, None)?;
         check(&model)?;
         if corrects(spec, &model.cloud) {
-            model.correct(spec, phase, &layered, store);
+            model.correct(spec, phase, &layered, (store, weights));
         }
         Ok(model)
     }
@@ -576,7 +599,7 @@ impl Model {
         spec: &ModelSpec,
         phase: bool,
         layered: &[bool],
-        store: Option<&dyn Store>,
+        store: (Option<&dyn Store>, Weights),
     ) {
         let cloud = &self.cloud;
         let bond_conductivity = if phase {

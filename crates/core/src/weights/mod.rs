@@ -45,8 +45,11 @@
 
 mod additive;
 mod coarse;
+mod cost;
 mod direct;
 pub mod store;
+
+pub use cost::{estimate, Estimate, Path};
 
 use crate::cloud::Cloud;
 use crate::math::{Real, Vector};
@@ -713,14 +716,8 @@ pub fn correct_reusing(
         return correct(k, cloud, sel, conductivity, order);
     };
     let key = store::key(k, cloud, sel, conductivity, order);
-    if let Some(found) = store.load(&key, k.vals.len(), k.n_rows()) {
-        progress::report(progress::Event::WeightsLoaded);
-        store_vals(k, found.vals);
-        let summary = Consistency {
-            reused: true,
-            ..found.summary
-        };
-        return (summary, found.met);
+    if let Some(found) = load(k, &key, store) {
+        return found;
     }
     let (summary, met) = correct(k, cloud, sel, conductivity, order);
     let solved = store::SolvedRef {
@@ -730,6 +727,35 @@ pub fn correct_reusing(
     };
     store.save(&key, solved);
     (summary, met)
+}
+
+/// The weights of the problem of [`correct`] loaded from `store` into `k`, or None (`k`
+/// unchanged, nothing solved) when the store does not hold them: what `peritherm check` does.
+pub fn correct_stored(
+    k: &mut Conductance,
+    cloud: &Cloud,
+    sel: &[bool],
+    conductivity: &[Real],
+    order: Order,
+    store: &dyn store::Store,
+) -> Option<(Consistency, Vec<bool>)> {
+    load(k, &store::key(k, cloud, sel, conductivity, order), store)
+}
+
+/// The weights kept under `key` loaded into `k`, with their summary (marked reused).
+fn load(
+    k: &mut Conductance,
+    key: &store::Key,
+    store: &dyn store::Store,
+) -> Option<(Consistency, Vec<bool>)> {
+    let found = store.load(key, k.vals.len(), k.n_rows())?;
+    progress::report(progress::Event::WeightsLoaded);
+    store_vals(k, found.vals);
+    let summary = Consistency {
+        reused: true,
+        ..found.summary
+    };
+    Some((summary, found.met))
 }
 
 /// [`correct`] with `factor_room` bytes for a direct factorisation of the Newton matrix
