@@ -2,7 +2,7 @@
 # The consistent weights' set-up against the cloud's size, beside what `peritherm check`
 # estimated for it: in 2D cases/large/scale_square.toml (unit square of gmsh default triangles,
 # δ = 3Δ, defaults otherwise) on meshes/scale_square_L1..L4.msh (1.6·10⁴ to 1.0·10⁶ nodes), in
-# 3D cases/conv_cube_tet.toml on meshes/conv_cube_tet_L1..L4.msh (712 to 287 757 nodes). Each
+# 3D cases/large/scale_cube.toml on meshes/conv_cube_tet_L1..L4.msh (712 to 287 757 nodes). Each
 # level is run with the weights cache off on 2 threads, beside the same model with
 # `kernel.consistency = "none"`: set-up time, check's estimate, Newton and CG iterations, peak
 # resident set of both (GNU time). Writes validation/setup_scaling.json and the table of
@@ -26,7 +26,7 @@ import figure_file
 THREADS = 2
 FAMILIES = {
     "square": ("cases/large/scale_square.toml", "../../meshes/scale_square_{}.msh"),
-    "cube": ("cases/conv_cube_tet.toml", "../meshes/conv_cube_tet_{}.msh"),
+    "cube": ("cases/large/scale_cube.toml", "../../meshes/conv_cube_tet_{}.msh"),
 }
 UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}
 
