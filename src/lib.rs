@@ -1,8 +1,8 @@
 //! peritherm: transient heat conduction with dual-horizon peridynamics.
 //!
 //! The numerics follow `docs/theory.md` (the model in one notation), which reconciles four
-//! papers: Bobaru & Duangpanya 2010 (1D), Bobaru & Duangpanya 2012 (2D, cracks), the
-//! axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) and Wang, Oterkus &
+//! papers: Bobaru & Duangpanya 2010 (1D), Bobaru & Duangpanya 2012 (2D, cracks), PCS2022
+//! (doi:10.1007/s42102-022-00092-3) and Wang, Oterkus &
 //! Oterkus's dual-horizon thermal diffusion; the full references are at the end of
 //! `docs/theory.md`.
 //!

@@ -273,7 +273,7 @@ pub struct Row {
     pub mean_abs: Option<f64>,
     /// Bobaru & Duangpanya 2012, eq. 13 along the case's probe line (classical references only).
     pub eq13: Option<f64>,
-    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
+    /// PCS2022 (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
     /// / max |θ_ref| (the other run's field is the reference when comparing with a run).
     pub epsilon: Option<f64>,
     /// Volume-weighted relative L2 error over all body nodes, ‖θ − θ_ref‖/‖θ_ref‖

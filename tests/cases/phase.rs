@@ -1,4 +1,4 @@
-//! Enthalpy form and phase change (theory §6; the axisymmetric phase-change paper
+//! Enthalpy form and phase change (theory §6; PCS2022
 //! (doi:10.1007/s42102-022-00092-3)): the enthalpy stepper against the linear one, energy
 //! conservation with phase change in symmetric bodies, and planar freezing against Neumann's
 //! solution.
@@ -201,7 +201,7 @@ fn energy_is_conserved_with_phase_change_in_symmetric_bodies() {
 /// Planar freezing: water at +5 °C, the face x = 0 held at −10 °C by a mirrored layer. The front
 /// (where half of a node's latent heat is gone) follows Neumann's X(t) = 2λ√(α_f t) within two node
 /// spacings at every hour of two days (the criterion). Δ = 5 mm, δ = 3Δ, constant kernel
-/// (as in the axisymmetric phase-change paper); the far face (0.6 m, ~4 liquid diffusion lengths
+/// (as in PCS2022); the far face (0.6 m, ~4 liquid diffusion lengths
 /// away) is held at +5 °C.
 #[test]
 fn planar_freezing_follows_the_neumann_front() {
@@ -278,7 +278,7 @@ fn planar_freezing_follows_the_neumann_front() {
     PHASE.row(&[PHASE.keys[2], &measured, "2Δ"], PHYSICAL);
 }
 
-/// Water's T(H) and λ(H) of the axisymmetric phase-change paper, eqs 1–3, written out again for the
+/// Water's T(H) and λ(H) of PCS2022, eqs 1–3, written out again for the
 /// reference below.
 fn water_state(h: f64) -> (f64, f64) {
     let (cf, cm, tf, l) = (2060.0e3, 4182.0e3, 273.15, 333e6);
@@ -291,7 +291,7 @@ fn water_state(h: f64) -> (f64, f64) {
     }
 }
 
-/// An independent classical reference for the axisymmetric phase-change paper §3.3: a radial
+/// An independent classical reference for PCS2022 §3.3: a radial
 /// finite-volume enthalpy solve (cells of width `dr` on [r0, r1], harmonic face conductivities, the
 /// extracted flux `q` through the inner face, the outer face held at `outer` half a cell away),
 /// forward Euler at half its stability limit. Returns the temperatures at each of `times`.
@@ -335,7 +335,7 @@ fn radial_freezing(r0: f64, r1: f64, dr: f64, q: f64, outer: f64, times: &[f64])
     out
 }
 
-/// The axisymmetric phase-change paper §3.3, freezing around a pipe (the bundled case, 1D
+/// PCS2022 §3.3, freezing around a pipe (the bundled case, 1D
 /// axisymmetric): against the radial finite-volume enthalpy reference with 2 mm cells at 1, 2 and 3
 /// days. Measures: ε of its eq 27 ≤ 0.5% (the criterion for the symmetric cases) and the
 /// ice front (T = T_f crossing) within two node spacings.

@@ -1,4 +1,4 @@
-//! Axisymmetric and spherical peridynamics (the axisymmetric phase-change paper,
+//! Axisymmetric and spherical peridynamics (PCS2022,
 //! doi:10.1007/s42102-022-00092-3, §2.2–2.4; theory §7): steady radial states against their exact
 //! solutions (second-order δ-convergence), the cooling sphere against its series, exact energy
 //! conservation of an insulated axisymmetric body, and the radial heat flux of the paper's eq 25
@@ -74,8 +74,8 @@ fn max_error(model: &Model, theta: &[f64], exact: &dyn Fn(f64) -> f64) -> f64 {
 /// Steady PD states of the wall at Δ = 1/40, 1/80, 1/160 of its thickness (m = 3) against the exact
 /// radial solutions: the largest nodal error falls as δ², observed rate ≥ 1.8 between every pair
 /// (measured 1.98–2.00), and is below 0.05 °C of the 100 °C span at the finest spacing (measured
-/// 2.4e-3, 2.5e-3 and 6.5e-3 °C). - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a)) (the
-/// axisymmetric phase-change paper, eq 10's Ω);
+/// 2.4e-3, 2.5e-3 and 6.5e-3 °C). - axisymmetric 1D and 2D: θ = 100 (1 − ln(r/a)/ln(b/a))
+/// (PCS2022, eq 10's Ω);
 /// - spherical shell: θ = A + B/r, B = 100 a b/(b − a), A = −B/b (eq 21's Ω_sp).
 ///
 /// A planar operator (Ω = 1) would give the straight line, up to 8.6 °C (at r = 0.72 m) away
@@ -114,8 +114,8 @@ fn steady_radial_states_converge_at_second_order() {
     }
 }
 
-/// The radial PD heat flux (theory §8 with the true ring volume, i.e. the axisymmetric phase-change
-/// paper, eq 25: q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric
+/// The radial PD heat flux (theory §8 with the true ring volume, i.e. PCS2022,
+/// eq 25: q_i = −Σ_{j hotter} Ω(r_j, r_i) c V_j (θ_j − θ_i) ξ_ij) of the steady axisymmetric
 /// wall (1D, and 2D with its axial component) against Fourier's −k dθ/dr = 100 k/(r ln(b/a)), at Δ
 /// = (b − a)/80 and (b − a)/160: - nodes beyond the reach of the mirrored layers (δ + Δ/2 from both
 /// faces): for θ linear in ln r the first-order terms of Ω and of
@@ -174,7 +174,7 @@ fn radial_flux_matches_fourier() {
     }
 }
 
-/// The axisymmetric phase-change paper §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k =
+/// PCS2022 §3.2 on a coarse grid: the copper sphere (R = 0.1 m, k =
 /// 400, ρ = 8920, c = 385, θ0 = 1000 K, surface 300 K by mirrored layers, centre free) with Δ =
 /// R/20, R/40, R/80 (δ = 3Δ), forward Euler at 0.9 of the stable step, against the series
 /// `sphere_fixed_surface` at t = 2, 5 and 10 s: ε (its eq 27) falls as δ², observed rate ≥ 1.8

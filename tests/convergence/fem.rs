@@ -921,7 +921,7 @@ fn symmetric_steady_states_converge_at_second_order() {
     }
 }
 
-/// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3) §3.2 (copper sphere R = 0.1
+/// PCS2022 (doi:10.1007/s42102-022-00092-3) §3.2 (copper sphere R = 0.1
 /// m, θ0 = 1000 K, surface held at 300 K, centre free) at t = 10 s on linear elements of h = R/40 …
 /// R/320 (3-point Gauss: 4πr² N_a N_b is of degree 4) against the series of
 /// `analytic::sphere_fixed_surface` (exact diffusivity k/(ρc)). Crank–Nicolson with Δt = 2.5e-3 s
@@ -989,7 +989,7 @@ fn sphere_converges_at_second_order() {
 }
 
 /// `[reference.fem] mesh`: a gmsh case solved on another mesh with the same group names. The pipe
-/// section of the axisymmetric phase-change paper §3.4 on quads of 0.04 m solved on the quads of
+/// section of PCS2022 §3.4 on quads of 0.04 m solved on the quads of
 /// 0.02 m: the other mesh's 41 × 41 nodes, its boundary sets found by name (heated band 0.2 m long,
 /// the insulated rest 3.0 m), and the ring volume ∫2πr dA = π(1.2² − 0.4²)·0.8 m³ to round-off
 /// (1e-12 relative; bilinear quads and 2πr integrate exactly). A mesh without the case's region, or

@@ -105,7 +105,7 @@ pub enum Reference {
         initial: f64,
     },
     /// Sphere of radius R about the origin, surface held, uniform initial temperature
-    /// (the axisymmetric phase-change paper, doi:10.1007/s42102-022-00092-3, §3.2): θ = θ_s + (θ_0
+    /// (PCS2022, doi:10.1007/s42102-022-00092-3, §3.2): θ = θ_s + (θ_0
     /// − θ_s)(2R/(πr)) Σ (−1)^(n+1)/n sin(nπr/R) e^(−α n²π² t/R²), r = √(x² + y² + z²) (the radius
     /// of a 1D radial model is x).
     SphereFixedSurface {

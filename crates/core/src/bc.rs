@@ -2,9 +2,9 @@
 //!
 //! Constraints overwrite node temperatures at each stage (nodal Dirichlet, the 1D flux
 //! relation of Bobaru & Duangpanya 2010, eq. 22, the nodal flux relation of Bobaru & Duangpanya
-//! 2012 §3.2, and the fictitious layers of Wang, Oterkus & Oterkus and the axisymmetric
-//! phase-change paper); loads add to the rates (convection of the axisymmetric phase-change paper
-//! (doi:10.1007/s42102-022-00092-3), volumetric sources).
+//! 2012 §3.2, and the fictitious layers of Wang, Oterkus & Oterkus and PCS2022);
+//! loads add to the rates (convection of PCS2022, doi:10.1007/s42102-022-00092-3, volumetric
+//! sources).
 
 use crate::cloud::{Cloud, Fictitious, Reflection};
 use crate::expr::Expr;
@@ -53,7 +53,7 @@ pub enum FaceBc {
         /// q(x, y, z, t) into the body, W/m².
         value: Expr,
     },
-    /// Convection through a mirrored fictitious layer (the axisymmetric phase-change paper §3.1c):
+    /// Convection through a mirrored fictitious layer (PCS2022 §3.1c):
     /// the ghost at distance d from its mirror node satisfies k(θ_f − θ_m)/d = h(T∞ − (θ_f +
     /// θ_m)/2), i.e. θ_f = ((1 − β/2) θ_m + β T∞)/(1 + β/2) with β = h d/k.
     LayerConvection {
@@ -62,7 +62,7 @@ pub enum FaceBc {
         /// T∞(t), °C.
         ambient: Expr,
     },
-    /// Convection to an ambient temperature (the axisymmetric phase-change paper): s = h A (T∞ −
+    /// Convection to an ambient temperature (PCS2022): s = h A (T∞ −
     /// θ)/V on surface nodes.
     Convection {
         /// Film coefficient h, W/(m²·K).

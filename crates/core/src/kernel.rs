@@ -54,7 +54,7 @@ pub enum Calibration {
 /// A micro-conductivity kernel: exponent p, profile and partial-volume rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Kernel {
-    /// Exponent p of 1/r^p: 2 (Bobaru & Duangpanya 2010, 2012; the axisymmetric phase-change paper)
+    /// Exponent p of 1/r^p: 2 (Bobaru & Duangpanya 2010, 2012; PCS2022)
     /// or 1 (Wang, Oterkus & Oterkus).
     pub p: u8,
     /// Profile w.

@@ -1,4 +1,4 @@
-//! Materials, their enthalpy–temperature relation (theory §6, the axisymmetric phase-change paper
+//! Materials, their enthalpy–temperature relation (theory §6, PCS2022
 //! (doi:10.1007/s42102-022-00092-3), eqs. 1–3) and the bond-conductivity rule at interfaces (theory
 //! §2.4).
 
@@ -14,14 +14,14 @@ pub struct Material {
     pub density: f64,
     /// Specific heat c (C_m), J/(kg·K).
     pub specific_heat: f64,
-    /// Freezing/melting at one temperature (the axisymmetric phase-change paper §2.1); None for a
+    /// Freezing/melting at one temperature (PCS2022 §2.1); None for a
     /// linear material.
     #[serde(default)]
     pub phase_change: Option<PhaseChange>,
 }
 
-/// `[material.<name>.phase_change]`: the frozen phase and the latent heat (the axisymmetric
-/// phase-change paper, eqs. 1–3).
+/// `[material.<name>.phase_change]`: the frozen phase and the latent heat (PCS2022,
+/// eqs. 1–3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PhaseChange {
@@ -66,7 +66,7 @@ pub struct Enthalpy {
 }
 
 impl Enthalpy {
-    /// Temperature at enthalpy `h` (the axisymmetric phase-change paper, eq. 3), °C.
+    /// Temperature at enthalpy `h` (PCS2022, eq. 3), °C.
     #[inline]
     pub fn temperature(&self, h: f64) -> f64 {
         if h < self.h_solid {
@@ -88,7 +88,7 @@ impl Enthalpy {
         }
     }
 
-    /// Conductivity at enthalpy `h` (the axisymmetric phase-change paper, eq. 1: the mean of λ_f
+    /// Conductivity at enthalpy `h` (PCS2022, eq. 1: the mean of λ_f
     /// and λ_m on the plateau), W/(m·K).
     #[inline]
     pub fn conductivity(&self, h: f64) -> f64 {
@@ -257,7 +257,7 @@ impl Material {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BondRule {
-    /// 2 k_a k_b / (k_a + k_b) (the axisymmetric phase-change paper, default).
+    /// 2 k_a k_b / (k_a + k_b) (PCS2022, default).
     #[default]
     Harmonic,
     /// min(k_a, k_b) (Bobaru & Duangpanya 2012, composites).
@@ -306,7 +306,7 @@ mod tests {
         for t in [200.0, 273.0, 273.2, 300.0, 373.15] {
             assert!((e.temperature(e.enthalpy(t)) - t).abs() < 1e-9 * t, "{t}");
         }
-        // the axisymmetric phase-change paper, eq. 3: the plateau is ρ_f Π L wide and sits at T_f
+        // PCS2022, eq. 3: the plateau is ρ_f Π L wide and sits at T_f
         let hs = 1000.0 * 2060.0 * 273.15;
         assert_eq!(e.temperature(hs + 0.5 * 1000.0 * 333e3), 273.15);
         assert!((e.temperature(hs + 1000.0 * 333e3 + 4182.0e3) - 274.15).abs() < 1e-9);

@@ -122,7 +122,7 @@ pub struct ModelSpec {
     /// Restore, at nodes whose bonds a pre-crack cuts, the second moment of their horizon
     /// ([`crate::crack::restore_moment`]).
     pub crack_correction: bool,
-    /// Planar, axisymmetric or spherical body (the axisymmetric phase-change paper; theory §7).
+    /// Planar, axisymmetric or spherical body (PCS2022; theory §7).
     pub symmetry: Symmetry,
 }
 

@@ -3,8 +3,8 @@
 //! `V_i ρc_i dθ_i/dt = Σ_j K_ij (θ_j − θ_i)` with `K_ij = V_i V_j (w_ij + w_ji)` and the
 //! directed half-conductances `w_ij = ½ c_i(|ξ_ij|) β_ij` (Wang, Oterkus & Oterkus, eqs. 19–24;
 //! w_ij = 0 when j ∉ H_i). K is symmetric, so the bond sum conserves energy exactly. Axisymmetric
-//! and spherical clouds multiply each pair by the factor of [`crate::symmetry`] (the axisymmetric
-//! phase-change paper, eqs. 10 and 21).
+//! and spherical clouds multiply each pair by the factor of [`crate::symmetry`] (PCS2022,
+//! eqs. 10 and 21).
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;

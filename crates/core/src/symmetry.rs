@@ -1,11 +1,11 @@
-//! Axial and spherical symmetry (the axisymmetric phase-change paper §2.2–2.3; theory §7).
+//! Axial and spherical symmetry (PCS2022 §2.2–2.3; theory §7).
 //!
 //! A symmetric model is computed on a planar cloud: the x coordinate is the radius r and, for
 //! an axisymmetric 2D model, y is the axial coordinate z. Each node stands for a ring
 //! (axisymmetric) or a shell (spherical). Its true volume is its planar measure times
 //! [`Symmetry::volume_factor`] (2πr or 4πr²), and each pair conductance is the planar one
 //! times [`Symmetry::pair_factor`]. Dividing a pair factor by a node's volume factor gives
-//! the shape factors of the axisymmetric phase-change paper, Ω (eq. 10) and Ω_sp (eq. 21), so the
+//! the shape factors of PCS2022, Ω (eq. 10) and Ω_sp (eq. 21), so the
 //! per-node balance is exactly the paper's eq. (23) while K stays symmetric and energy is
 //! conserved.
 
@@ -56,8 +56,8 @@ impl Symmetry {
 
     /// Factor multiplying the planar pair conductance of nodes at radii `ri` and `rj`:
     /// 1, 2π·2 ri rj/(ri + rj) or 4π·3 ri² rj²/(ri² + ri rj + rj²). Symmetric in (ri, rj);
-    /// divided by [`Symmetry::volume_factor`]`(ri)` it is Ω(rj, ri) of the axisymmetric
-    /// phase-change paper (doi:10.1007/s42102-022-00092-3), eq. (10) or Ω_sp(rj, ri) of eq. (21).
+    /// divided by [`Symmetry::volume_factor`]`(ri)` it is Ω(rj, ri) of PCS2022
+    /// (doi:10.1007/s42102-022-00092-3), eq. (10) or Ω_sp(rj, ri) of eq. (21).
     #[inline]
     pub fn pair_factor(&self, ri: f64, rj: f64) -> f64 {
         use std::f64::consts::PI;
@@ -73,7 +73,7 @@ impl Symmetry {
         }
     }
 
-    /// The shape factor (the axisymmetric phase-change paper) of a bond from a node at `r` to one
+    /// The shape factor (PCS2022) of a bond from a node at `r` to one
     /// at `r_other`: Ω = 2r'/(r' + r) (eq. 10) or Ω_sp = 3r'²/(r² + r r' + r'²) (eq. 21); 1 when
     /// planar.
     pub fn shape_factor(&self, r_other: f64, r: f64) -> f64 {

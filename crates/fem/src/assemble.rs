@@ -72,7 +72,7 @@ fn element(
     for &(xi, w) in quadrature_for(c.kind, mesh.symmetry) {
         let s = shape(c.kind, xi);
         let (g, det) = physical(c.kind, &s, &x, mesh.dim);
-        // ring/shell measure at the quadrature point (the axisymmetric phase-change paper,
+        // ring/shell measure at the quadrature point (PCS2022,
         // doi:10.1007/s42102-022-00092-3, §2.2–2.3): 2πr or 4πr² dr
         let at = Point::from((0..n).map(|a| x[a].coords * s.n[a]).sum::<Vector>());
         let dv = w * det * mesh.tau * mesh.symmetry_weight(&at);

@@ -107,7 +107,7 @@ impl FemMesh {
     }
 
     /// Weight of a quadrature point at `p` from the body's symmetry: 1 (planar), 2πr or 4πr²
-    /// with r = x (the ring and shell measures of the axisymmetric phase-change paper,
+    /// with r = x (the ring and shell measures of PCS2022,
     /// doi:10.1007/s42102-022-00092-3), m⁰, m or m².
     #[inline]
     pub fn symmetry_weight(&self, p: &Point) -> f64 {

@@ -343,7 +343,7 @@ pub struct Comparison {
     pub mean_sq_rel_diff: f64,
     /// Bobaru & Duangpanya 2012, eq. 13 along the probe line (all nodes when no line is set).
     pub l2_rel_line: f64,
-    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
+    /// PCS2022 (doi:10.1007/s42102-022-00092-3), eq. 27: rms difference
     /// / max |θ_c|.
     pub epsilon: f64,
     /// Relative L2 error over all body nodes compared, weighted by node volume:

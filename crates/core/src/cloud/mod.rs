@@ -2,7 +2,7 @@
 //!
 //! A cloud holds the body nodes first (`0..n_body`) and the fictitious boundary-layer
 //! nodes after them (the fictitious regions of Wang, Oterkus & Oterkus, the mirror/naive layers of
-//! the axisymmetric phase-change paper). Every node has its own spacing Δ and horizon δ, which is
+//! PCS2022). Every node has its own spacing Δ and horizon δ, which is
 //! what dual horizon needs (Wang, Oterkus & Oterkus §3).
 
 pub mod facets;
@@ -110,7 +110,7 @@ pub struct Cloud {
     pub max: Point,
     /// Whether nodes sit on the boundary with partial volumes (Bobaru & Duangpanya 2012 §3).
     pub boundary_placement: bool,
-    /// Planar, or rings/shells about the axis x = 0 (the axisymmetric phase-change paper; theory
+    /// Planar, or rings/shells about the axis x = 0 (PCS2022; theory
     /// §7).
     pub symmetry: Symmetry,
 }

@@ -23,7 +23,7 @@ pub enum Engine<'a> {
 
 impl<'a> Engine<'a> {
     /// Chooses and sets up the stepper of `integrator` on `model`: the enthalpy form of
-    /// forward Euler for phase change (the axisymmetric phase-change paper,
+    /// forward Euler for phase change (PCS2022,
     /// doi:10.1007/s42102-022-00092-3, refusing other integrators), the implicit stepper
     /// (system eliminated and factorised symbolically; `adaptive` steps visit several Δt, so
     /// CG until a factorisation pays, [`Solver::Auto`]) or the explicit one.

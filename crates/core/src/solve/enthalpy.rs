@@ -1,10 +1,10 @@
-//! Forward Euler in enthalpy form, for models with phase change (the axisymmetric phase-change
-//! paper, doi:10.1007/s42102-022-00092-3, eqs. 3 and 24, theory §6).
+//! Forward Euler in enthalpy form, for models with phase change (PCS2022,
+//! doi:10.1007/s42102-022-00092-3, eqs. 3 and 24, theory §6).
 //!
 //! Each body node carries its enthalpy per unit volume H_i and θ_i = T(H_i). The step is
 //! `V_i (H_i' − H_i)/Δt = Σ_j λ̄_ij K_ij (θ_j − θ_i) + V_i s_i`, with K the model's pair
 //! conductance for unit conductivity and λ̄_ij the bond rule's mean of the two nodes' λ(H)
-//! (harmonic by default, the axisymmetric phase-change paper, eq. 5). λ̄ is symmetric, so energy Σ
+//! (harmonic by default, PCS2022, eq. 5). λ̄ is symmetric, so energy Σ
 //! V_i H_i is conserved by the bond sum. Buffers are allocated once; the bond sum is a parallel
 //! gather.
 

@@ -1,5 +1,5 @@
-//! Explicit time integration: forward Euler (Wang, Oterkus & Oterkus; the axisymmetric phase-change
-//! paper, doi:10.1007/s42102-022-00092-3) and classical RK4 (Bobaru & Duangpanya 2010, 2012).
+//! Explicit time integration: forward Euler (Wang, Oterkus & Oterkus; PCS2022,
+//! doi:10.1007/s42102-022-00092-3) and classical RK4 (Bobaru & Duangpanya 2010, 2012).
 //!
 //! The rate of a free body node is `Σ_j K_ij (θ_j − θ_i)/(V_i ρc_i)` plus loads; driven nodes
 //! (Dirichlet, flux relations) and fictitious nodes are set by the boundary at every stage.

@@ -9,7 +9,7 @@
 //! |---|---|---|---|
 //! | 2D, one sparse Cholesky factor | conv_rect_tri_L2, 2.78·10⁵, 2.63 s | conv_rect_tri_L4, 4.32·10⁶, 186.7 s | 1.55 |
 //! | 2D, two-level CG | conv_rect_tri_L2, 2.78·10⁵, 7.7 s | conv_rect_tri_L3, 1.10·10⁶, 94 s | 1.82 |
-//! | 3D, two-level CG | conv_cube_tet_L2, 9.30·10⁵, 2.82 s | conv_cube_tet_L3, 7.11·10⁶, 48.3 s | 1.40 |
+//! | 3D, two-level CG | conv_cube_tet_L3, 7.11·10⁶, 48.3 s | conv_cube_tet_L4, 5.39·10⁷, 1 082.6 s | 1.54 |
 //!
 //! The 2D CG path is taken only above the direct factor's limit, so its law is extrapolated
 //! from a forced run far below it. An estimate, not a measurement: expect it within a factor of
@@ -43,7 +43,7 @@ pub struct Estimate {
 /// Fitted law (pairs at the anchor, seconds there, exponent) of a path in `dim` dimensions.
 fn law(dim: usize, path: Path) -> (Real, Real, Real) {
     match (dim, path) {
-        (3, _) => (7.11e6, 48.3, 1.40),
+        (3, _) => (5.39e7, 1082.6, 1.54),
         (_, Path::Direct) => (4.32e6, 186.7, 1.55),
         (_, Path::TwoLevel) => (2.78e5, 7.7, 1.82),
     }
@@ -94,8 +94,8 @@ mod tests {
         let big = estimate(2, Order::Quadratic, 1_027_614, 37_135_828);
         assert_eq!(big.path, Path::TwoLevel);
         assert!(big.seconds > 3600.0, "{big:?}");
-        let cube = estimate(3, Order::Quadratic, 36_447, 7_110_000);
-        assert!((cube.seconds - 48.3).abs() < 1e-9 * 48.3, "{cube:?}");
+        let cube = estimate(3, Order::Quadratic, 287_757, 53_900_000);
+        assert!((cube.seconds - 1082.6).abs() < 1e-9 * 1082.6, "{cube:?}");
         assert_eq!(estimate(2, Order::None, 10, 100).seconds, 0.0);
     }
 }

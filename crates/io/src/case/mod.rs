@@ -55,8 +55,8 @@ pub struct CaseFile {
     pub title: String,
     /// Spatial dimension, 1..=3.
     pub dimension: usize,
-    /// `planar` (default), `axisymmetric` (x = r, y = z) or `spherical` (x = r); the axisymmetric
-    /// phase-change paper (doi:10.1007/s42102-022-00092-3).
+    /// `planar` (default), `axisymmetric` (x = r, y = z) or `spherical` (x = r); PCS2022
+    /// (doi:10.1007/s42102-022-00092-3).
     #[serde(default)]
     pub symmetry: Symmetry,
     /// The built-in box domain (or give `mesh`).

@@ -34,8 +34,7 @@ pub struct TimeSpec {
     /// Time step, s (default: 0.95 of the stable bound).
     #[serde(default)]
     pub dt: Option<f64>,
-    /// euler, rk4 or an implicit scheme (default rk4; euler with phase change, the axisymmetric
-    /// phase-change paper).
+    /// euler, rk4 or an implicit scheme (default rk4; euler with phase change, PCS2022).
     #[serde(default)]
     pub integrator: Option<Integrator>,
     /// Output times, s (default: the end time).

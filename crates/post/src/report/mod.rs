@@ -187,14 +187,14 @@ pub struct FieldDifference {
 }
 
 impl FieldDifference {
-    /// The axisymmetric phase-change paper (doi:10.1007/s42102-022-00092-3), eq. 27 with B as the
+    /// PCS2022 (doi:10.1007/s42102-022-00092-3), eq. 27 with B as the
     /// reference: ε = rms(θ_b − θ_a) / max |θ_b| (0 when B is zero everywhere), dimensionless.
     pub fn epsilon(&self) -> f64 {
         epsilon(self.rms, self.reference_max_abs)
     }
 }
 
-/// The axisymmetric phase-change paper, eq. 27 from its two parts: ε = rms / max |T_ref| (0 when
+/// PCS2022, eq. 27 from its two parts: ε = rms / max |T_ref| (0 when
 /// the reference is zero everywhere), dimensionless.
 pub fn epsilon(rms: f64, reference_max_abs: f64) -> f64 {
     if reference_max_abs > 0.0 {
@@ -301,7 +301,7 @@ mod tests {
     use super::*;
     use peritherm_core::analytic::Reference;
 
-    /// The axisymmetric phase-change paper, eq. 27 by its definition: a field off the reference by
+    /// PCS2022, eq. 27 by its definition: a field off the reference by
     /// the same d at every node has rms d, so ε = d / max |T_ref| whatever the field; a difference
     /// at one node of N gives rms d/√N. Both for `compare` (classical references) and
     /// `field_difference` (runs: a linear reference field is interpolated exactly). Tolerance:

@@ -131,8 +131,8 @@ pub fn draw_maps(
     for (k, (f, t)) in fields.iter().zip(&summary.output_times).enumerate() {
         let cracks = segments_at(&cutters, *t);
         let several_regions = f.region.iter().any(|&r| r != f.region[0]);
-        // phase fronts: the isotherms at each phase-change temperature (the axisymmetric
-        // phase-change paper Fig. 13)
+        // phase fronts: the isotherms at each phase-change temperature (PCS2022
+        // Fig. 13)
         let fronts: Vec<[Point; 2]> = case
             .spec
             .materials
