@@ -757,7 +757,7 @@ fn weights_estimate(case: &Case, model: &peritherm::model::Model) -> String {
     use peritherm::weights::{estimate, Path};
     let order = case.spec.consistency;
     let (nodes, pairs) = (model.cloud.n_body, model.conductance.vals.len());
-    let e = estimate(model.cloud.dim, order, nodes, pairs);
+    let e = estimate(model.cloud.dim, order, nodes as f64, pairs as f64);
     let how = match e.path {
         Path::Direct => format!(
             "one sparse factor of about {}",

@@ -93,7 +93,7 @@ fn build_as(case: &Case, options: &Options, writes: bool, weights: Weights) -> R
     let store = options.store(writes);
     let store = store.as_ref().map(|s| s as &dyn Store);
     // the semantic checks run before the consistent weights are solved
-    Model::build_checked_as(&case.spec, (store, weights), |model| semantic(case, model))
+    Model::build_checked(&case.spec, (store, weights), |model| semantic(case, model))
         .map_err(|e| keyed(case, e))
 }
 

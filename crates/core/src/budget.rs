@@ -6,13 +6,11 @@ use crate::cloud::{BoxGeometry, HorizonRule};
 use crate::error::Result;
 use crate::kernel::PartialVolume;
 use crate::limits::{
-    BYTES_PER_BOND, BYTES_PER_NODE, CORRECTION_BYTES_PER_ENTRY, FEM_BYTES_PER_ENTRY,
-    IMPLICIT_BOND_FACTOR, MAX_DIRECT_ENTRIES, MAX_NEIGHBOURS, MEMORY_FRACTION,
-    SHARED_BYTES_PER_NODE,
+    BYTES_PER_BOND, BYTES_PER_NODE, FEM_BYTES_PER_ENTRY, IMPLICIT_BOND_FACTOR, MAX_NEIGHBOURS,
+    MEMORY_FRACTION, SHARED_BYTES_PER_NODE,
 };
 use crate::machine::Memory;
 use crate::model::{Geometry, ModelSpec};
-use crate::weights::Order;
 use serde::Serialize;
 
 /// Estimated size of a model, with the key that drives it.
@@ -179,25 +177,15 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
 }
 
 /// Bytes of the consistent weights' direct solve on a mesh cloud (every node takes part): the
-/// Newton matrix's entries times [`CORRECTION_BYTES_PER_ENTRY`] where one factor solves it
-/// (2D, at most [`MAX_DIRECT_ENTRIES`]), else 0 (CG, whose vectors the per-node bytes cover).
+/// direct factor of [`crate::weights::estimate`] (2D, at most
+/// [`crate::limits::MAX_DIRECT_ENTRIES`] entries at [`crate::limits::CORRECTION_BYTES_PER_ENTRY`]), else 0 (CG, whose vectors the per-node bytes cover).
 fn correction_bytes(spec: &ModelSpec, dim: usize, per_region: &[(f64, f64, f64)]) -> f64 {
-    let nu = match spec.consistency {
-        Order::None => return 0.0,
-        Order::Linear => dim as f64,
-        Order::Quadratic => (dim + dim * (dim + 1) / 2) as f64,
-    };
-    if dim == 3 || spec.symmetry.is_symmetric() {
+    if spec.symmetry.is_symmetric() {
         return 0.0;
     }
     let nodes: f64 = per_region.iter().map(|r| r.0 + r.1).sum();
-    let pairs: f64 = per_region.iter().map(|r| r.2).sum::<f64>() / 2.0;
-    let entries = pairs * nu * nu + nodes * nu * (nu + 1.0) / 2.0;
-    if entries <= MAX_DIRECT_ENTRIES {
-        entries * CORRECTION_BYTES_PER_ENTRY
-    } else {
-        0.0
-    }
+    let pairs: f64 = per_region.iter().map(|r| r.2).sum();
+    crate::weights::estimate(dim, spec.consistency, nodes, pairs).bytes
 }
 
 /// Per box region: body nodes, fictitious nodes of the layers on its faces that carry one,

@@ -560,19 +560,10 @@ impl Model {
     /// [`Model::build_with`], calling `check` on the model before its consistent weights are
     /// solved (they are the expensive part of a set-up and change nothing `check` should
     /// read but K): a case `check` refuses is refused in the time of a set-up without them.
-    /// The model is the same bits as [`Model::build_with`]'s.
-    pub fn build_checked(
-        spec: &ModelSpec,
-        store: Option<&dyn Store>,
-        check: impl Fn(&Model) -> Result<()>,
-    ) -> Result<Model> {
-        Self::build_checked_as(spec, (store, Weights::Solve), check)
-    }
-
-    /// [`Model::build_checked`], solving the consistent weights or only loading stored ones
-    /// (`weights`); with [`Weights::StoredOnly`] and nothing stored, K stays uncorrected and
+    /// With [`Weights::Solve`] the model is the same bits as [`Model::build_with`]'s; with
+    /// [`Weights::StoredOnly`] and nothing in `store`, K stays uncorrected and
     /// [`Model::correction`] is None.
-    pub fn build_checked_as(
+    pub fn build_checked(
         spec: &ModelSpec,
         (store, weights): (Option<&dyn Store>, Weights),
         check: impl Fn(&Model) -> Result<()>,

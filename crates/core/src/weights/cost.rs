@@ -51,14 +51,15 @@ fn law(dim: usize, path: Path) -> (Real, Real, Real) {
 
 /// The estimated set-up of the weights of `order` for `nodes` corrected nodes and `pairs`
 /// stored pairs (CSR entries of K) in `dim` dimensions, every node taking part (a mesh; on a
-/// lattice only the band around a change of horizon does, and this is an upper bound).
-pub fn estimate(dim: usize, order: Order, nodes: usize, pairs: usize) -> Estimate {
+/// lattice only the band around a change of horizon does, and this is an upper bound). The
+/// counts are reals: the memory budget estimates them for hostile cases whose counts overflow
+/// integers.
+pub fn estimate(dim: usize, order: Order, nodes: Real, pairs: Real) -> Estimate {
     let nu = match order {
         Order::None => 0.0,
         Order::Linear => dim as Real,
         Order::Quadratic => (dim + dim * (dim + 1) / 2) as Real,
     };
-    let (nodes, pairs) = (nodes as Real, pairs as Real);
     // the lower triangle of the Newton matrix: half the pairs' blocks and the diagonal ones
     let entries = 0.5 * pairs * nu * nu + nodes * nu * (nu + 1.0) / 2.0;
     let path = if dim < 3 && entries <= MAX_DIRECT_ENTRIES {
@@ -88,14 +89,14 @@ mod tests {
     /// The law returns its anchors, and the path switches at the direct factor's limit.
     #[test]
     fn estimates_meet_their_anchors() {
-        let e = estimate(2, Order::Quadratic, 118_600, 4_320_000);
+        let e = estimate(2, Order::Quadratic, 118_600.0, 4_320_000.0);
         assert_eq!(e.path, Path::Direct);
         assert!((e.seconds - 186.7).abs() < 1e-9 * 186.7, "{e:?}");
-        let big = estimate(2, Order::Quadratic, 1_027_614, 37_135_828);
+        let big = estimate(2, Order::Quadratic, 1_027_614.0, 37_135_828.0);
         assert_eq!(big.path, Path::TwoLevel);
         assert!(big.seconds > 3600.0, "{big:?}");
-        let cube = estimate(3, Order::Quadratic, 287_757, 53_900_000);
+        let cube = estimate(3, Order::Quadratic, 287_757.0, 53_900_000.0);
         assert!((cube.seconds - 1082.6).abs() < 1e-9 * 1082.6, "{cube:?}");
-        assert_eq!(estimate(2, Order::None, 10, 100).seconds, 0.0);
+        assert_eq!(estimate(2, Order::None, 10.0, 100.0).seconds, 0.0);
     }
 }
