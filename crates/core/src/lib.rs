@@ -16,6 +16,7 @@ pub mod cloud;
 pub mod crack;
 pub mod error;
 pub mod expr;
+pub mod gather;
 pub mod kernel;
 pub mod limits;
 pub mod machine;

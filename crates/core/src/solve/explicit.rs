@@ -6,8 +6,9 @@
 //! Buffers are allocated once; the bond sum is a parallel gather.
 
 use crate::error::Result;
+use crate::gather::Rows;
 use crate::model::Model;
-use crate::operator::{row_sum, Conductance, ROW_CHUNK};
+use crate::operator::{Conductance, ROW_CHUNK};
 use crate::solve::exchange::Exchange;
 use crate::stencil::Stencils;
 use rayon::prelude::*;
@@ -21,41 +22,16 @@ pub use crate::solve::stepper::{check_finite, RunStats};
 use crate::solve::stepper::{march, Stepper};
 pub use crate::solve::steps::{count_steps, steps_between};
 
-fn rates(
-    model: &Model,
-    k: &Conductance,
-    theta: &[f64],
-    t: f64,
-    rows: Range<usize>,
-    out: &mut [f64],
-) {
-    rates_with(model, k, None, theta, t, rows, out);
-}
-
 /// The rate of every body row of `rows` into `out` (every body node; the other rows are left
-/// as they are, or set by the loads), through the stencils of K when there are some (the
-/// same bits), K/s.
-fn rates_with(
-    model: &Model,
-    k: &Conductance,
-    stencils: Option<&Stencils>,
-    theta: &[f64],
-    t: f64,
-    rows: Range<usize>,
-    out: &mut [f64],
-) {
+/// as they are, or set by the loads), K/s: 0 at driven nodes, the bond sum over the heat
+/// capacity plus the loads at free ones.
+fn rates(model: &Model, k: Rows, theta: &[f64], t: f64, rows: Range<usize>, out: &mut [f64]) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
     let mine = &mut out[rows.clone()];
-    if let Some(st) = stencils {
-        st.for_rows(theta, mine, rows.clone(), |i, s, o| {
-            *o = if driven[i] { 0.0 } else { s * inv[i] };
-        });
-    } else {
-        csr_rows(k, theta, rows.clone(), driven, mine, |i, s, _, o| {
-            *o = if driven[i] { 0.0 } else { s * inv[i] };
-        });
-    }
+    k.gather(theta, rows.clone(), driven, mine, |i, s, _, o| {
+        *o = if driven[i] { 0.0 } else { s * inv[i] };
+    });
     if model.boundary.has_loads() {
         model
             .boundary
@@ -68,43 +44,13 @@ fn rates_with(
     }
 }
 
-/// Calls `f(i, Σ_j K_ij (θ_j − θ_i), θ_i, out_i)` for every body row `i` of `rows` through the
-/// plain CSR rows of K, in parallel tasks of [`ROW_CHUNK`] rows (`out` holds the rows `rows`);
-/// the sum is not formed (0 is passed) for the rows marked in `skip` (driven nodes).
-#[inline(always)]
-fn csr_rows(
-    k: &Conductance,
-    theta: &[f64],
-    rows: Range<usize>,
-    skip: &[bool],
-    out: &mut [f64],
-    f: impl Fn(usize, f64, f64, &mut f64) + Sync,
-) {
-    out.par_chunks_mut(ROW_CHUNK)
-        .enumerate()
-        .for_each(|(c, o)| {
-            let first = rows.start + c * ROW_CHUNK;
-            let off = &k.offsets[first..=first + o.len()];
-            for (r, (o, w)) in o.iter_mut().zip(off.windows(2)).enumerate() {
-                let i = first + r;
-                let ti = theta[i];
-                let s = match skip[i] {
-                    true => 0.0,
-                    false => row_sum(&k.cols[w[0]..w[1]], &k.vals[w[0]..w[1]], theta, ti),
-                };
-                f(i, s, ti, o);
-            }
-        });
-}
-
 /// One fused forward-Euler update of the body rows `rows`, gather form: `next_i = θ_i +
 /// h·Σ_j K_ij (θ_j − θ_i)/(V_i ρc_i)` for free nodes, `θ_i` for driven ones (the boundary sets
 /// them after), into `next` (the rows `rows`). The same bits as [`rates`] followed by
-/// `θ_i += h·rate_i`, in one pass; through the stencils of K when there are some.
+/// `θ_i += h·rate_i`, in one pass.
 fn euler_fused(
     model: &Model,
-    k: &Conductance,
-    stencils: Option<&Stencils>,
+    k: Rows,
     theta: &[f64],
     h: f64,
     rows: Range<usize>,
@@ -112,14 +58,7 @@ fn euler_fused(
 ) {
     let inv = &model.inv_heat_capacity;
     let driven = &model.boundary.driven;
-    if let Some(st) = stencils {
-        st.for_rows(theta, next, rows, |i, s, o| {
-            let ti = theta[i];
-            *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
-        });
-        return;
-    }
-    csr_rows(k, theta, rows, driven, next, |i, s, ti, o| {
+    k.gather(theta, rows, driven, next, |i, s, ti, o| {
         *o = if driven[i] { ti } else { ti + h * (s * inv[i]) };
     });
 }
@@ -131,8 +70,11 @@ pub struct Explicit<'a> {
     conductance: Cow<'a, Conductance>,
     /// Index of the next growing-crack cut in `model.growth`.
     next_cut: usize,
-    integrator: ExplicitScheme,
-    k: [Vec<f64>; 4],
+    /// The explicit scheme stepped.
+    scheme: ExplicitScheme,
+    /// The rates of the scheme's stages (RK4: k1 … k4; Euler: the first only), K/s.
+    rates: [Vec<f64>; 4],
+    /// The temperatures at an RK4 stage, °C.
     stage: Vec<f64>,
     /// K as shared stencils for the Euler step (lattice clouds without growing cracks).
     stencils: Option<Stencils>,
@@ -153,13 +95,13 @@ fn stencils_for(model: &Model, scheme: ExplicitScheme) -> Option<Stencils> {
 
 impl<'a> Explicit<'a> {
     /// Allocates the buffers for a model.
-    pub fn new(model: &'a Model, integrator: ExplicitScheme) -> Self {
+    pub fn new(model: &'a Model, scheme: ExplicitScheme) -> Self {
         let nb = model.cloud.n_body;
-        let stages = match integrator {
+        let stages = match scheme {
             ExplicitScheme::Rk4 => 4,
             ExplicitScheme::Euler => 1,
         };
-        let k = std::array::from_fn(|s| {
+        let rates = std::array::from_fn(|s| {
             if s < stages {
                 vec![0.0; nb]
             } else {
@@ -175,10 +117,10 @@ impl<'a> Explicit<'a> {
             model,
             conductance,
             next_cut: 0,
-            integrator,
-            k,
+            scheme,
+            rates,
             stage: vec![0.0; model.cloud.len()],
-            stencils: stencils_for(model, integrator),
+            stencils: stencils_for(model, scheme),
             rows: 0..nb,
             exchange: None,
         }
@@ -200,7 +142,7 @@ impl<'a> Explicit<'a> {
         self.stencils = match (on, self.stencils.take()) {
             (false, _) => None,
             (true, Some(s)) => Some(s),
-            (true, None) => stencils_for(self.model, self.integrator),
+            (true, None) => stencils_for(self.model, self.scheme),
         };
         self.stencils.is_some()
     }
@@ -234,32 +176,22 @@ impl<'a> Explicit<'a> {
     pub fn step(&mut self, theta: &mut [f64], t: f64, h: f64) {
         self.cut_until(t);
         let m = self.model;
-        let k = &*self.conductance;
         let rows = self.rows.clone();
-        // built from the model's K: not used once something owns a copy of K to change it
-        let st = match self.conductance {
-            Cow::Borrowed(_) => self.stencils.as_ref(),
-            Cow::Owned(_) => None,
+        // the stencils are built from the model's K: not used once a copy of K is cut
+        let k = match (&self.conductance, &self.stencils) {
+            (Cow::Borrowed(_), Some(st)) => Rows::Stencils(st),
+            (k, _) => Rows::Csr(k),
         };
-        match self.integrator {
+        let out = &mut self.rates[0];
+        match self.scheme {
             ExplicitScheme::Euler if m.boundary.has_loads() => {
-                rates_with(m, k, st, theta, t, rows.clone(), &mut self.k[0]);
-                update(&mut theta[rows.clone()], &self.k[0][rows], |y, r| {
-                    *y += h * r
-                });
+                rates(m, k, theta, t, rows.clone(), out);
+                update(&mut theta[rows.clone()], &out[rows], |y, r| *y += h * r);
             }
             ExplicitScheme::Euler => {
-                // the new body temperatures into k[0], then back into θ (the caller's slice)
-                euler_fused(
-                    m,
-                    k,
-                    st,
-                    theta,
-                    h,
-                    rows.clone(),
-                    &mut self.k[0][rows.clone()],
-                );
-                update(&mut theta[rows.clone()], &self.k[0][rows], |y, n| *y = n);
+                // the new body temperatures into the rate buffer, then back into θ
+                euler_fused(m, k, theta, h, rows.clone(), &mut out[rows.clone()]);
+                update(&mut theta[rows.clone()], &out[rows], |y, n| *y = n);
             }
             ExplicitScheme::Rk4 => self.rk4(theta, t, h),
         }
@@ -268,9 +200,9 @@ impl<'a> Explicit<'a> {
 
     /// One classical RK4 step of the rows of this stepper (the constraints set at each stage).
     fn rk4(&mut self, theta: &mut [f64], t: f64, h: f64) {
-        let (m, k, ex) = (self.model, &*self.conductance, self.exchange);
+        let (m, k, ex) = (self.model, Rows::Csr(&self.conductance), self.exchange);
         let r = self.rows.clone();
-        let [k1, k2, k3, k4] = &mut self.k;
+        let [k1, k2, k3, k4] = &mut self.rates;
         let stage = &mut self.stage;
         rates(m, k, theta, t, r.clone(), k1);
         stage.copy_from_slice(theta);
