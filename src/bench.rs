@@ -1,11 +1,11 @@
 //! `peritherm bench`: throughput of the explicit step against the machine's memory bandwidth.
 //!
 //! Measures, on this machine and with the same code the runs use: a STREAM-like triad
-//! (a_i = b_i + s c_i) on 1 and N threads, the bond updates per second of one forward-Euler
-//! step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3) through the CSR rows and the stencils
-//! of K, each step after a triad pass on the same threads (the machine may be shared: both see
-//! the same load), the time of the neighbour search and of the assembly of K, and the bytes
-//! held per bond. Every figure is the median of repeated timings; nothing is estimated.
+//! (a_i = b_i + s c_i) and a read-only pass on 1 and N threads, the bond updates per second of
+//! one forward-Euler step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3) through the CSR rows
+//! and the stencils of K, each step after a read-only pass on the same threads (the machine may
+//! be shared: both see the same load), the time of the neighbour search and of the assembly of
+//! K, and the bytes held and streamed per bond. Every figure is the median of repeated timings; nothing is estimated.
 
 use crate::case::Case;
 use crate::error::{Error, Result};
@@ -86,12 +86,14 @@ pub struct StepRow {
     pub step_1: f64,
     /// Median time of one Euler step on N threads, s.
     pub step_n: f64,
-    /// Median triad bandwidth on 1 thread measured between the steps, GB/s.
-    pub triad_1: f64,
-    /// Median triad bandwidth on N threads measured between the steps, GB/s.
-    pub triad_n: f64,
+    /// Median read bandwidth on 1 thread measured between the steps, GB/s.
+    pub read_1: f64,
+    /// Median read bandwidth on N threads measured between the steps, GB/s.
+    pub read_n: f64,
     /// Bytes held by Horizons + Conductance per stored pair conductance, B.
     pub bytes_per_bond: f64,
+    /// Bytes one step reads and writes per stored pair conductance ([`streamed_bytes`]), B.
+    pub streamed_per_bond: f64,
     /// Bytes held by the stencils per stored pair conductance (0 for CSR), B.
     pub stencil_bytes_per_bond: f64,
 }
@@ -122,6 +124,10 @@ pub struct BenchReport {
     pub triad_1: f64,
     /// Triad bandwidth on N threads, GB/s.
     pub triad_n: f64,
+    /// Read-only bandwidth on 1 thread, GB/s.
+    pub read_1: f64,
+    /// Read-only bandwidth on N threads, GB/s.
+    pub read_n: f64,
     /// Explicit-step rows.
     pub steps: Vec<StepRow>,
     /// Set-up rows.
@@ -194,34 +200,38 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// The arrays of a STREAM-like triad a_i = b_i + s·c_i.
-pub struct Triad {
+/// The arrays of the bandwidth kernels: a STREAM-like triad a_i = b_i + s·c_i, and a
+/// read-only pass summing b and c (the limit of a read-dominated loop such as the step).
+pub struct Bandwidth {
     a: Vec<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
 }
 
-impl Triad {
+/// Elements per parallel task of the bandwidth kernels.
+const BANDWIDTH_CHUNK: usize = 1 << 16;
+
+impl Bandwidth {
     /// Three arrays of `len` f64, every page touched.
-    pub fn new(len: usize) -> Triad {
+    pub fn new(len: usize) -> Bandwidth {
         use rayon::prelude::*;
-        Triad {
+        Bandwidth {
             a: vec![1.0; len],
             b: (0..len).into_par_iter().map(|i| i as f64).collect(),
             c: (0..len).into_par_iter().map(|i| 0.5 * i as f64).collect(),
         }
     }
 
-    /// One pass on `pool`, s.
-    pub fn pass(&mut self, pool: &ThreadPool) -> f64 {
+    /// One triad pass on `pool`, s.
+    pub fn triad(&mut self, pool: &ThreadPool) -> f64 {
         use rayon::prelude::*;
         let (a, b, c) = (&mut self.a, &self.b, &self.c);
         let s = 3.0;
         let t = Instant::now();
         pool.install(|| {
-            a.par_chunks_mut(1 << 16)
-                .zip(b.par_chunks(1 << 16))
-                .zip(c.par_chunks(1 << 16))
+            a.par_chunks_mut(BANDWIDTH_CHUNK)
+                .zip(b.par_chunks(BANDWIDTH_CHUNK))
+                .zip(c.par_chunks(BANDWIDTH_CHUNK))
                 .for_each(|((a, b), c)| {
                     for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
                         *a = b + s * c;
@@ -233,16 +243,47 @@ impl Triad {
         dt
     }
 
-    /// Bandwidth of a pass that took `seconds`, GB/s, counting 24 bytes per element as STREAM
-    /// does.
-    pub fn gbs(&self, seconds: f64) -> f64 {
+    /// One read-only pass on `pool` (Σ b_i + c_i, in eight independent partial sums so that
+    /// the adds do not bound it), s.
+    pub fn read(&self, pool: &ThreadPool) -> f64 {
+        use rayon::prelude::*;
+        let t = Instant::now();
+        let sum: f64 = pool.install(|| {
+            self.b
+                .par_chunks(BANDWIDTH_CHUNK)
+                .zip(self.c.par_chunks(BANDWIDTH_CHUNK))
+                .map(|(b, c)| {
+                    let mut acc = [0.0f64; 8];
+                    for (b, c) in b.chunks_exact(8).zip(c.chunks_exact(8)) {
+                        for k in 0..8 {
+                            acc[k] += b[k] + c[k];
+                        }
+                    }
+                    acc.iter().sum::<f64>()
+                })
+                .sum()
+        });
+        let dt = t.elapsed().as_secs_f64();
+        std::hint::black_box(sum);
+        dt
+    }
+
+    /// Bandwidth of a triad pass that took `seconds`, GB/s, counting 24 bytes per element as
+    /// STREAM does.
+    pub fn triad_gbs(&self, seconds: f64) -> f64 {
         24.0 * self.a.len() as f64 / seconds / 1e9
     }
 
-    /// Median bandwidth of `reps` passes on `pool`, GB/s.
-    pub fn median_gbs(&mut self, pool: &ThreadPool, reps: usize) -> f64 {
-        let t: Vec<f64> = (0..reps).map(|_| self.pass(pool)).collect();
-        self.gbs(median(t))
+    /// Bandwidth of a read pass that took `seconds`, GB/s (16 bytes read per element).
+    pub fn read_gbs(&self, seconds: f64) -> f64 {
+        16.0 * self.b.len() as f64 / seconds / 1e9
+    }
+
+    /// Median triad and read bandwidths of `reps` passes each on `pool`, GB/s.
+    pub fn median_gbs(&mut self, pool: &ThreadPool, reps: usize) -> (f64, f64) {
+        let t: Vec<f64> = (0..reps).map(|_| self.triad(pool)).collect();
+        let r: Vec<f64> = (0..reps).map(|_| self.read(pool)).collect();
+        (self.triad_gbs(median(t)), self.read_gbs(median(r)))
     }
 }
 
@@ -296,17 +337,35 @@ pub fn bond_bytes(model: &Model) -> usize {
         + k.diag.capacity() * 8
 }
 
-/// Euler steps of `model` on `pool` in three blocks of `reps / 3`, each block after two triad
-/// passes on the same pool and one discarded step (so that steps and triad see the same load
-/// from elsewhere, and no timed step pays for evicting the triad's arrays), through the
-/// stencils of K or the plain CSR rows: median step, s, median triad bandwidth, GB/s, and the
+/// Bytes per row that every kernel of the Euler step moves: θ_i read, the new θ_i written,
+/// 1/(V_i ρc_i) read, the driven flag read, then the copy of the new θ back (read and write).
+const ROW_BYTES: usize = 8 + 8 + 8 + 1 + 16;
+
+/// Bytes one forward-Euler step moves between memory and the cores, each array counted once
+/// (the neighbours' θ_j are reused from cache in space-filling-curve order): the rows'
+/// [`ROW_BYTES`], and K as the kernel reads it. CSR: a u64 offset per row, a u32 column and
+/// an f64 K_ij per bond; stencils (`stencil_bytes` held): a u16 stencil index per row and the
+/// stencils themselves, B.
+pub fn streamed_bytes(model: &Model, stencil_bytes: Option<usize>) -> f64 {
+    let rows = model.cloud.n_body;
+    let k = match stencil_bytes {
+        None => rows * 8 + model.conductance.nnz() * BYTES_PER_BOND as usize,
+        Some(held) => rows * 2 + held,
+    };
+    (rows * ROW_BYTES + k) as f64
+}
+
+/// Euler steps of `model` on `pool` in three blocks of `reps / 3`, each block after two read
+/// passes on the same pool and one discarded step (so that steps and reads see the same load
+/// from elsewhere, and no timed step pays for evicting the read's arrays), through the
+/// stencils of K or the plain CSR rows: median step, s, median read bandwidth, GB/s, and the
 /// stencils' bytes (None when they are not used).
 pub fn time_step(
     pool: &ThreadPool,
     model: &Model,
     reps: usize,
     stencils: bool,
-    triad: &mut Triad,
+    bandwidth: &Bandwidth,
 ) -> (f64, f64, Option<usize>) {
     let dt = 0.5 * Integrator::Euler.stable_dt(model);
     let mut theta = model.theta0.clone();
@@ -316,8 +375,8 @@ pub fn time_step(
     let mut passes = Vec::new();
     let per_block = reps.div_ceil(3).max(1);
     for _ in 0..3 {
-        passes.push(triad.pass(pool));
-        passes.push(triad.pass(pool));
+        passes.push(bandwidth.read(pool));
+        passes.push(bandwidth.read(pool));
         pool.install(|| st.step(&mut theta, 0.0, dt)); // not timed
         for _ in 0..per_block {
             let t = Instant::now();
@@ -328,7 +387,7 @@ pub fn time_step(
     std::hint::black_box(&theta);
     (
         median(steps),
-        triad.gbs(median(passes)),
+        bandwidth.read_gbs(median(passes)),
         used.then(|| st.stencil_bytes()),
     )
 }
@@ -379,14 +438,14 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
     };
     let reps = if opts.quick { 5 } else { 15 };
     say(&format!(
-        "triad, {} MB per array",
+        "triad and read, {} MB per array",
         (bench.triad_len * 8) >> 20
     ));
-    let mut triad = Triad::new(bench.triad_len);
-    let triad_1 = triad.median_gbs(&bench.p1, reps);
-    let triad_n = triad.median_gbs(&bench.pn, reps);
+    let mut bandwidth = Bandwidth::new(bench.triad_len);
+    let (triad_1, read_1) = bandwidth.median_gbs(&bench.p1, reps);
+    let (triad_n, read_n) = bandwidth.median_gbs(&bench.pn, reps);
     // made again beside each model, so that it does not add to the build's peak memory
-    drop(triad);
+    drop(bandwidth);
     let mut steps = Vec::new();
     let mut setup = Vec::new();
     for (name, dim, cells, m) in plate_configs(opts) {
@@ -418,6 +477,8 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         threads: opts.threads,
         triad_1,
         triad_n,
+        read_1,
+        read_n,
         steps,
         setup,
         peak_rss: peak_rss(),
@@ -451,7 +512,7 @@ struct Bench {
     p1: ThreadPool,
     /// All the threads asked for.
     pn: ThreadPool,
-    /// Length of each triad array (doubles).
+    /// Length of each bandwidth-kernel array (doubles).
     triad_len: usize,
     /// Repetitions of each timed step.
     step_reps: usize,
@@ -486,19 +547,18 @@ impl Bench {
     }
 
     /// The explicit step of `model` timed on one and on all threads, with the CSR kernel
-    /// and with stencils (when rows repeat), each beside a triad.
+    /// and with stencils (when rows repeat), each beside a read-only pass.
     fn step_rows(&self, name: &str, model: &Model, say: &mut impl FnMut(&str)) -> Vec<StepRow> {
         let nnz = model.conductance.nnz() as f64;
-        let mut triad = Triad::new(self.triad_len);
+        let bandwidth = Bandwidth::new(self.triad_len);
         let mut rows = Vec::new();
         for (kernel, on) in [("CSR", false), ("stencils", true)] {
-            let (step_1, triad_1, used) =
-                time_step(&self.p1, model, self.step_reps, on, &mut triad);
+            let (step_1, read_1, used) = time_step(&self.p1, model, self.step_reps, on, &bandwidth);
             let Some(held) = (if on { used } else { Some(0) }) else {
                 say(&format!("{name}: no stencils (rows do not repeat)"));
                 continue;
             };
-            let (step_n, triad_n, _) = time_step(&self.pn, model, self.step_reps, on, &mut triad);
+            let (step_n, read_n, _) = time_step(&self.pn, model, self.step_reps, on, &bandwidth);
             rows.push(StepRow {
                 name: name.to_string(),
                 kernel,
@@ -506,9 +566,10 @@ impl Bench {
                 bonds: model.conductance.nnz(),
                 step_1,
                 step_n,
-                triad_1,
-                triad_n,
+                read_1,
+                read_n,
                 bytes_per_bond: bond_bytes(model) as f64 / nnz,
+                streamed_per_bond: streamed_bytes(model, on.then_some(held)) / nnz,
                 stencil_bytes_per_bond: held as f64 / nnz,
             });
         }
@@ -533,7 +594,7 @@ impl BenchReport {
 
     /// The tables as figure files (`bench_bandwidth`, `bench_step`, `bench_setup` and, with
     /// `--cases`, `bench_cases`), measured by `command`. With `--nodes N` the one plate's
-    /// `bench_step_<N>`, `bench_setup_<N>` and `bench_memory_<N>` (N as 1e7): the triad beside
+    /// `bench_step_<N>`, `bench_setup_<N>` and `bench_memory_<N>` (N as 1e7): the read pass beside
     /// a model of that size is disturbed, so no bandwidth table.
     pub fn figures(&self, command: &str) -> Vec<peritherm_post::figures::Figures> {
         use peritherm_post::figures::from_markdown;
@@ -579,19 +640,21 @@ impl BenchReport {
         gbs * 1e9 / BYTES_PER_BOND
     }
 
-    /// The memory bandwidth table (triad on one and all threads).
+    /// The memory bandwidth table (triad and read-only pass on one and all threads).
     fn bandwidth_table(&self) -> String {
         let n = self.threads;
         let lim = Self::bond_limit;
         let mut s = String::new();
-        s += "| memory bandwidth (STREAM-like triad) | 1 thread | ";
+        s += "| memory bandwidth | 1 thread | ";
         s += &format!("{n} threads |\n|---|---|---|\n");
         s += &format!(
-            "| triad, GB/s | {:.1} | {:.1} |\n| bond-update limit at {BYTES_PER_BOND} B/bond, 10⁹/s | {:.2} | {:.2} |\n\n",
+            "| STREAM-like triad, GB/s | {:.1} | {:.1} |\n| read-only, GB/s | {:.1} | {:.1} |\n| bond-update limit at {BYTES_PER_BOND} B/bond read, 10⁹/s | {:.2} | {:.2} |\n\n",
             self.triad_1,
             self.triad_n,
-            lim(self.triad_1) / 1e9,
-            lim(self.triad_n) / 1e9
+            self.read_1,
+            self.read_n,
+            lim(self.read_1) / 1e9,
+            lim(self.read_n) / 1e9
         );
         s
     }
@@ -599,15 +662,16 @@ impl BenchReport {
     /// The explicit step table: one row per plate and kernel.
     fn step_table(&self) -> String {
         let n = self.threads;
-        let lim = Self::bond_limit;
         let mut s = format!(
-            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | triad alongside, 1 / {n} threads | of the 12 B/bond limit, 1 / {n} threads | B held per bond (+ stencils) |\n"
+            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | read alongside, 1 / {n} threads | B held per bond (+ stencils) | B streamed per bond | of the read limit, 1 / {n} threads |\n"
         );
-        s += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for r in &self.steps {
             let (r1, rn) = (r.bonds as f64 / r.step_1, r.bonds as f64 / r.step_n);
+            // the bandwidth the step used over the read-only pass's
+            let of_read = |rate: f64, gbs: f64| 100.0 * rate * r.streamed_per_bond / (gbs * 1e9);
             s += &format!(
-                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} / {:.2} × 10⁹ | {:.1} / {:.1} GB/s | {:.0} / {:.0} % | {:.1} (+ {:.2}) |\n",
+                "| {} | {} | {} | {} | {:.2} ms | {:.2} ms | {:.2}× | {:.2} / {:.2} × 10⁹ | {:.1} / {:.1} GB/s | {:.1} (+ {:.2}) | {:.2} | {:.0} / {:.0} % |\n",
                 r.name,
                 r.kernel,
                 r.nodes,
@@ -617,12 +681,13 @@ impl BenchReport {
                 r.step_1 / r.step_n,
                 r1 / 1e9,
                 rn / 1e9,
-                r.triad_1,
-                r.triad_n,
-                100.0 * r1 / lim(r.triad_1),
-                100.0 * rn / lim(r.triad_n),
+                r.read_1,
+                r.read_n,
                 r.bytes_per_bond,
-                r.stencil_bytes_per_bond
+                r.stencil_bytes_per_bond,
+                r.streamed_per_bond,
+                of_read(r1, r.read_1),
+                of_read(rn, r.read_n),
             );
         }
         s
