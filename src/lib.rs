@@ -17,9 +17,10 @@
 //! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.
 #![warn(missing_docs)]
 
+pub use peritherm_analytic as analytic;
 pub use peritherm_core::{
-    analytic, bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model,
-    neighbors, operator, partition, progress, solve, spatial, stencil, symmetry, weights,
+    bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model, neighbors,
+    operator, partition, progress, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{
     atomic, case, gmsh, history, output, provenance, reference, series, staging, weights_cache,

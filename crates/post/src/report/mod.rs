@@ -299,7 +299,7 @@ fn fit_at(dim: usize, x: &Point, near: &[(usize, f64)], b: (&[Point], &[f64])) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use peritherm_core::analytic::Reference;
+    use peritherm_analytic::Reference;
 
     /// PCS2022, eq. 27 by its definition: a field off the reference by
     /// the same d at every node has rms d, so ε = d / max |T_ref| whatever the field; a difference
