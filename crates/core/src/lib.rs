@@ -6,8 +6,8 @@
 //! It reads and writes no file and must not depend on file formats, plotting or the command
 //! line (no toml, serde_json, mshio, plotters, clap, indicatif, ctrlc or anyhow): the layers
 //! above it (`peritherm-fem`, `peritherm-analytic`, `peritherm-io`, `peritherm-post`,
-//! `peritherm`) depend on it, never the other way round. Its [`Error`] is the error
-//! vocabulary of every layer.
+//! `peritherm`) depend on it, never the other way round. Its [`Error`] holds the numerics'
+//! errors only; the layers above raise their own and wrap it.
 #![warn(missing_docs)]
 
 pub mod bc;

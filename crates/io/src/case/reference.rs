@@ -1,10 +1,10 @@
 //! `[reference]`: the classical solution a run is compared with, and where.
 
 use super::Ctx;
+use crate::error::Result;
 use crate::reference::ReferenceTable;
 use crate::series::SeriesCheck;
 use peritherm_analytic::Reference;
-use peritherm_core::error::Result;
 use peritherm_core::limits::MAX_HISTORY_POINTS;
 use peritherm_core::math::Point;
 use peritherm_fem::{FemOptions, Scheme};
