@@ -321,7 +321,7 @@ end = 1.0
 integrator = "euler"
 "#
     );
-    Case::parse(&text, Path::new("bench.toml"))
+    Ok(Case::parse(&text, Path::new("bench.toml"))?)
 }
 
 /// Bytes held by the bond data of a model (neighbour lists and K), B.

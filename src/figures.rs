@@ -61,7 +61,7 @@ pub fn table(
     let summaries = runs
         .iter()
         .map(|dir| RunSummary::read(dir))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<peritherm_io::Result<Vec<_>>>()?;
     let pairs: Vec<(&Path, &RunSummary)> =
         runs.iter().map(PathBuf::as_path).zip(&summaries).collect();
     let threads = summaries.first().map_or(0, |s| s.threads);

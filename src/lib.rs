@@ -17,14 +17,15 @@
 //! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.
 #![warn(missing_docs)]
 
+pub use peritherm_analytic as analytic;
 pub use peritherm_core::{
-    analytic, bc, budget, cloud, crack, error, expr, kernel, limits, material, math, mesh, model,
-    neighbors, operator, partition, progress, solve, spatial, stencil, symmetry, weights,
+    bc, budget, cloud, crack, expr, kernel, limits, material, math, mesh, model, neighbors,
+    operator, partition, progress, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{
     atomic, case, gmsh, history, output, provenance, reference, series, staging, weights_cache,
 };
-pub use peritherm_post::{plot, report};
+pub use peritherm_post::{error, plot, report};
 
 pub mod bench;
 #[cfg(feature = "mpi")]
@@ -37,4 +38,6 @@ pub mod run;
 pub mod simulation;
 pub mod sweep;
 
+/// The drivers' error: post's, which wraps io's and core's ([`error::IoError`],
+/// [`error::CoreError`]).
 pub use error::{Error, Result};

@@ -5,7 +5,7 @@
 use crate::bc::{FaceBc, NonFinite};
 use crate::case::Case;
 use crate::cloud::FACE_NAMES;
-use crate::error::{Error, Result};
+use crate::error::{CoreError, Error, Result};
 use crate::limits::MAX_STEPS;
 use crate::model::{Geometry, Model, Weights};
 use crate::solve::exchange::{Collective, RankPlan, Reduce};
@@ -60,12 +60,16 @@ impl Plan<'_> {
     }
 }
 
-/// A library error keyed to the case file.
-pub fn keyed(case: &Case, e: Error) -> Error {
-    match e {
-        Error::UnstableDt { .. } => case.error("time.dt", e.to_string()),
-        other => case.keyed(other),
+/// An error of any layer keyed to the case file: an unstable step to `time.dt`, a model
+/// error's key to the file's key; every other error is returned as it is.
+pub fn keyed(case: &Case, e: impl Into<Error>) -> Error {
+    match e.into() {
+        Error::Core(e @ CoreError::UnstableDt { .. }) => case.error("time.dt", e.to_string()),
+        Error::Core(e) => case.keyed(e),
+        Error::Io(e) => case.keyed(e),
+        other => return other,
     }
+    .into()
 }
 
 /// Checks the budget, builds the model and runs the semantic checks on it.
@@ -174,6 +178,7 @@ impl BadExpression {
                 self.found.value, p.x, p.y, p.z
             ),
         )
+        .into()
     }
 }
 
@@ -435,10 +440,14 @@ fn within_budget(case: &Case, steps: f64, end: f64, key: &str, why: &str) -> Res
     if crate::limits::within(steps, MAX_STEPS) {
         return Ok(());
     }
-    Err(case.error(
-        key,
-        format!("{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"),
-    ))
+    Err(case
+        .error(
+            key,
+            format!(
+                "{steps:.3e} steps to reach {end} s with {why}; at most {MAX_STEPS:e} are allowed"
+            ),
+        )
+        .into())
 }
 
 /// Refuses an adaptive run whose largest step (`time.dt_max`, else a tenth of the span) needs

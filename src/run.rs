@@ -3,7 +3,7 @@
 use crate::atomic::write_atomic;
 use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::crack::tips_at;
-use crate::error::{Error, Result};
+use crate::error::{CoreError, Error, IoError, Result};
 use crate::fem::run_fem;
 use crate::history::{output_index, Recorder};
 use crate::model::crack_cutters;
@@ -104,7 +104,8 @@ pub fn run_ranked<'a>(
                         "a distributed implicit run needs a symmetric system, and this one is asymmetric to {:.1e} (interpolated mirror images or flux relations): run it on one rank, or with euler or rk4",
                         e.system().asymmetry
                     ),
-                ));
+                )
+                .into());
             } else {
                 "replicated"
             }
@@ -179,11 +180,17 @@ fn follow(case: &Case, model: &Model, plan: Plan, rank: &Rank) -> Result<()> {
     let schedule = plan.schedule();
     let Plan { mut engine, .. } = plan;
     if !agree(Some(exchange), true) {
-        return Err(Error::Peer);
+        return Err(CoreError::Peer.into());
     }
     let times = case.times();
     let mut theta = model.theta0.clone();
-    let peer = |ok: bool| if ok { Ok(()) } else { Err(Error::Peer) };
+    let peer = |ok: bool| {
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::from(CoreError::Peer))
+        }
+    };
     integrate(
         &mut engine,
         &schedule,
@@ -249,13 +256,13 @@ fn execute(
     } = plan;
     let setup_seconds = t_setup.elapsed().as_secs_f64();
     // first, so that a run that fails or is interrupted also says which case it was
-    let origin = crate::provenance::write_copy(out, case);
+    let origin = crate::provenance::write_copy(out, case).map_err(Error::from);
     let mut theta = model.theta0.clone();
     let initial_energy = model.energy(&theta);
     let t_run = Instant::now();
     let ready = origin.and_then(|origin| Ok((origin, OutputWriter::new(case, model, out)?)));
     if !agree(ex, ready.is_ok()) {
-        return Err(ready.err().unwrap_or(Error::Peer));
+        return Err(ready.err().unwrap_or(CoreError::Peer.into()));
     }
     let (origin, mut writer) = ready?;
     writer.pieces = pieces(ex);
@@ -278,7 +285,7 @@ fn execute(
             None => Ok(()),
         };
         match (agree(ex, written.is_ok()), written) {
-            (false, Ok(())) => Err(Error::Peer),
+            (false, Ok(())) => Err(CoreError::Peer.into()),
             (_, w) => w,
         }
     };
@@ -361,7 +368,7 @@ fn with_ranks(summary: &mut RunSummary, model: &Model, ranks: Option<Ranks>) {
 /// likely caused it ([`likely_cause`]).
 fn run_error(case: &Case, model: &Model, e: Error) -> Error {
     match e {
-        Error::NonFinite { node, time } => {
+        Error::Core(CoreError::NonFinite { node, time }) => {
             let p = model.cloud.pos[node];
             case.error(
                 likely_cause(case, model, node, time),
@@ -370,6 +377,7 @@ fn run_error(case: &Case, model: &Model, e: Error) -> Error {
                     p.x, p.y, p.z
                 ),
             )
+            .into()
         }
         other => keyed(case, other),
     }
@@ -537,7 +545,8 @@ impl<'a> OutputWriter<'a> {
                             "the comparison with the reference overflows at t = {t} s (max |diff| = {:e}); its values are too large",
                             c.max_abs_diff
                         ),
-                    ));
+                    )
+                    .into());
                 }
                 self.comparisons.push(c);
                 self.reference_seconds += started.elapsed().as_secs_f64();
@@ -576,7 +585,7 @@ impl OutputWriter<'_> {
         }
         let dir = piece_path(out, k, 0);
         let dir = dir.parent().expect("a piece's directory");
-        std::fs::create_dir_all(dir).map_err(|error| Error::Io {
+        std::fs::create_dir_all(dir).map_err(|error| IoError::Io {
             path: dir.to_path_buf(),
             error,
         })?;

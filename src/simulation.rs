@@ -7,7 +7,7 @@
 //! [`Simulation::step`] takes steps of exactly [`Simulation::dt`].
 
 use crate::case::Case;
-use crate::error::{Error, Result};
+use crate::error::{CoreError, Error, Result};
 use crate::math::Vector;
 use crate::model::Model;
 use crate::operator::Conductance;
@@ -221,7 +221,7 @@ impl<'a> Simulation<'a> {
     fn settle(&mut self) -> Result<()> {
         let t = self.t;
         self.engine.stepper().settle(&mut self.theta, t)?;
-        check_finite(&self.theta, self.model.cloud.n_body, t)
+        Ok(check_finite(&self.theta, self.model.cloud.n_body, t)?)
     }
 
     /// K as it is now (growing cracks cut; with phase change, the current conductivities),
@@ -308,7 +308,7 @@ impl<'a> Simulation<'a> {
                 damage: model.damage_at(t),
                 energy,
             });
-            Ok(())
+            Ok::<(), CoreError>(())
         };
         // adaptive steps or the steady solve: the implicit stepper's own loops
         let result = integrate(

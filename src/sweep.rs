@@ -6,7 +6,7 @@
 use crate::case::{Case, ReferenceSource};
 use crate::cloud::Cloud;
 use crate::crack::tips_at;
-use crate::error::{Error, Result};
+use crate::error::{IoError, Result};
 use crate::model::crack_cutters;
 use crate::output::{FieldRows, RunSummary};
 use crate::plot::{convergence_plot, line_plot, Labels, Legend, Series, Style};
@@ -77,7 +77,7 @@ pub struct Variant {
 /// All variants of the case file `path` (text `text`): the Cartesian product of `vary`, in
 /// order (the last key varies fastest). Labels start with `prefix`.
 pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<Vec<Variant>> {
-    let err = |key: &str, message: String| Error::Case {
+    let err = |key: &str, message: String| IoError::Case {
         file: path.to_path_buf(),
         key: key.to_string(),
         message,
@@ -111,7 +111,7 @@ pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<
             let text = toml::to_string(&table).expect("a TOML table serialises");
             let case = Case::parse(&text, path).map_err(|e| match e {
                 // line numbers of the rewritten text mean nothing to the user: name the settings
-                Error::Case { key, message, .. } => {
+                IoError::Case { key, message, .. } => {
                     let set: Vec<String> =
                         settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
                     let at = if key.starts_with("line ") {
@@ -141,16 +141,17 @@ pub fn variants(text: &str, path: &Path, prefix: &str, vary: &[Vary]) -> Result<
 /// The case file `path` with some keys set (`peritherm run --set KEY=VALUE`, one value each).
 pub fn load_with(path: &Path, set: &[Vary]) -> Result<Case> {
     if set.is_empty() {
-        return Case::load(path);
+        return Ok(Case::load(path)?);
     }
     if let Some(v) = set.iter().find(|v| v.values.len() != 1) {
-        return Err(Error::Case {
+        return Err(IoError::Case {
             file: path.to_path_buf(),
             key: format!("--set {}", v.key),
             message: "takes one value (`peritherm sweep --vary` takes several)".into(),
-        });
+        }
+        .into());
     }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Case {
+    let text = std::fs::read_to_string(path).map_err(|e| IoError::Case {
         file: path.to_path_buf(),
         key: "-".into(),
         message: format!("cannot read: {e}"),
@@ -526,11 +527,12 @@ impl<'a> VariantRun<'a> {
     /// The rows of the comparisons with the variant's own `[reference]`; an error without one.
     fn reference_rows(&self) -> Result<Vec<Row>> {
         if self.summary.reference.is_empty() {
-            return Err(Error::Case {
+            return Err(IoError::Case {
                 file: self.variant.case.path.clone(),
                 key: "reference".into(),
                 message: "the case has no [reference]; give the sweep a run to compare with".into(),
-            });
+            }
+            .into());
         }
         Ok(self
             .summary
@@ -557,14 +559,15 @@ impl<'a> VariantRun<'a> {
         let mut rows = Vec::new();
         for (i, t) in summary.output_times.iter().enumerate() {
             let Some(j) = reference.output_index(*t) else {
-                return Err(Error::Case {
+                return Err(IoError::Case {
                     file: reference_dir.join("run.json"),
                     key: "output_times".into(),
                     message: format!(
                         "has no output at t = {t} s, which {} writes",
                         self.variant.label
                     ),
-                });
+                }
+                .into());
             };
             let a = summary.read_field(&self.dir, i)?;
             let b = reference.read_field(reference_dir, j)?;
@@ -901,7 +904,7 @@ pub fn study(
 ) -> Result<(Vec<Variant>, Against)> {
     let mut all = Vec::new();
     for path in cases {
-        let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| IoError::Io {
             path: path.clone(),
             error,
         })?;

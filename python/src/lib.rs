@@ -5,6 +5,7 @@
 
 use numpy::{PyArray1, PyArray2};
 use peritherm::case::Case;
+use peritherm::error::IoError;
 use peritherm::fem::{run_fem, FemOptions, Scheme};
 use peritherm::history::output_index;
 use peritherm::model::Model;
@@ -21,16 +22,14 @@ use std::time::{Duration, Instant};
 /// The library's error as a Python exception carrying its one-line message: a case, key or
 /// model error (and a bad mesh, expression or step) is a `ValueError`, a file that cannot be
 /// written an `OSError`, anything else (a failed solve, a non-finite state) a `RuntimeError`.
-fn py_err(e: peritherm::Error) -> PyErr {
-    use peritherm::Error as E;
+fn py_err(e: impl Into<peritherm::Error>) -> PyErr {
+    use peritherm::error::{CoreError as C, IoError as I};
+    let e = e.into();
     let msg = e.to_string().replace('\n', " ");
-    match e {
-        E::Case { .. }
-        | E::Model { .. }
-        | E::Expr { .. }
-        | E::UnstableDt { .. }
-        | E::Mesh { .. } => PyValueError::new_err(msg),
-        E::Io { .. } => PyOSError::new_err(msg),
+    match (e.core(), e.io()) {
+        (Some(C::Model { .. } | C::Expr { .. } | C::UnstableDt { .. }), _)
+        | (_, Some(I::Case { .. } | I::Mesh { .. })) => PyValueError::new_err(msg),
+        (_, Some(I::Io { .. })) => PyOSError::new_err(msg),
         _ => PyRuntimeError::new_err(msg),
     }
 }
@@ -161,15 +160,15 @@ fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
 
 /// A parse error of the TOML made from a dict names a line of that text, which the user never
 /// saw: name the dotted key written on that line instead (`region[1].spacing`).
-fn keyed_by_line(e: peritherm::Error, text: &str) -> peritherm::Error {
-    let peritherm::Error::Case { file, key, message } = e else {
+fn keyed_by_line(e: IoError, text: &str) -> IoError {
+    let IoError::Case { file, key, message } = e else {
         return e;
     };
     let Some(line) = key
         .strip_prefix("line ")
         .and_then(|n| n.parse::<usize>().ok())
     else {
-        return peritherm::Error::Case { file, key, message };
+        return IoError::Case { file, key, message };
     };
     let mut table = String::new();
     let mut counts: std::collections::HashMap<String, usize> = Default::default();
@@ -201,7 +200,7 @@ fn keyed_by_line(e: peritherm::Error, text: &str) -> peritherm::Error {
             });
         }
     }
-    peritherm::Error::Case {
+    IoError::Case {
         file,
         key: found.filter(|k| !k.is_empty()).unwrap_or(key),
         message,
@@ -325,13 +324,8 @@ struct State {
 /// The options of a run from Python: `max_memory` and the weights cache that
 /// `$PERITHERM_CACHE` and `$PERITHERM_CACHE_SIZE` set, as for the command line.
 fn run_options(max_memory: Option<f64>) -> peritherm::Result<peritherm::prepare::Options> {
-    let cache =
-        peritherm::weights_cache::WeightsCache::configured(None, None).map_err(|message| {
-            peritherm::Error::Model {
-                key: "environment".into(),
-                message,
-            }
-        })?;
+    let cache = peritherm::weights_cache::WeightsCache::configured(None, None)
+        .map_err(|message| peritherm::Error::model("environment", message))?;
     Ok(peritherm::prepare::Options { max_memory, cache })
 }
 

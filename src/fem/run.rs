@@ -9,7 +9,7 @@ use crate::atomic::write_atomic;
 use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::cloud::Cloud;
 use crate::crack::Cutter;
-use crate::error::{Error, Result};
+use crate::error::{CoreError, Error, Result};
 use crate::math::Vector;
 use crate::model::crack_cutters;
 use crate::output::{field_csv, field_path, field_vtu, vtu_path, Comparison, Fields, RunSummary};
@@ -25,12 +25,12 @@ pub fn problem<'a>(case: &'a Case, opts: &'a FemOptions) -> FemProblem<'a> {
         outputs: &case.outputs,
         end: case.end,
         options: opts,
-        read_mesh: &crate::gmsh::read,
+        read_mesh: &|path| crate::gmsh::read(path).map_err(|e| e.to_string()),
     }
 }
 
 /// Builds mesh, matrices and conditions of `case` on elements of size `h` (box cases) or
-/// on its own mesh (errors keyed as [`Error::Model`]).
+/// on its own mesh (errors keyed as [`CoreError::Model`]).
 pub fn model(case: &Case, h: Option<f64>) -> Result<FemModel> {
     model_with(
         case,
@@ -43,18 +43,19 @@ pub fn model(case: &Case, h: Option<f64>) -> Result<FemModel> {
 
 /// Builds mesh, matrices and conditions of `case` with the mesh settings of `opts`.
 pub fn model_with(case: &Case, opts: &FemOptions) -> Result<FemModel> {
-    FemModel::build(&problem(case, opts))
+    Ok(FemModel::build(&problem(case, opts))?)
 }
 
-/// A library error keyed to the case file (a non-finite state to the key `state`).
-fn keyed(case: &Case, e: Error) -> Error {
+/// A numerics error keyed to the case file (a non-finite state to the key `state`).
+fn keyed(case: &Case, e: CoreError) -> Error {
     match e {
-        Error::NonFinite { time, .. } => case.error(
+        CoreError::NonFinite { time, .. } => case.error(
             "state",
             format!("fem: temperature became non-finite by t = {time:e} s; check source and boundary values"),
         ),
         other => case.keyed(other),
     }
+    .into()
 }
 
 /// Runs `case` with the FEM solver into `out`; `progress(done, total)` reports steps.
@@ -70,7 +71,7 @@ pub fn run_fem(
     if !(dt.is_finite() && dt > 0.0) {
         return Err(keyed(
             case,
-            Error::model("--dt", format!("fem: must be a positive step, got {dt}")),
+            CoreError::model("--dt", format!("fem: must be a positive step, got {dt}")),
         ));
     }
     budget(&problem, dt).map_err(|e| keyed(case, e))?;

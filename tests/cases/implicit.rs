@@ -5,6 +5,7 @@
 use crate::common::case::CaseToml;
 use crate::common::figures::Table;
 use peritherm::case::Case;
+use peritherm::error::CoreError;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::solve::implicit::{Adaptive, Implicit, Options, Ordering, Scheme, Solver};
@@ -183,7 +184,8 @@ fn steady_equals_linear_profile_and_long_explicit_run() {
     let mut theta = model.theta0.clone();
     let mut st = Implicit::new(&model, Scheme::Bdf2, Options::default()).unwrap();
     assert!(st.system().symmetric, "asymmetry {}", st.system().asymmetry);
-    st.steady(&mut theta, &[1.0], |_, _, _, _| Ok(())).unwrap();
+    st.steady(&mut theta, &[1.0], |_, _, _, _| Ok::<_, CoreError>(()))
+        .unwrap();
     let nb = model.cloud.n_body;
     let linear = (0..nb)
         .map(|i| (theta[i] - 100.0 * model.cloud.pos[i].x).abs())
@@ -468,7 +470,7 @@ fn adaptive(
         outputs,
         |_, _, th, _| {
             fields.push(th[..nb].to_vec());
-            Ok(())
+            Ok::<_, CoreError>(())
         },
         |_, _| {},
     )

@@ -15,6 +15,7 @@ const ROUND_OFF_TOL: f64 = 10.0;
 use crate::common::case::CaseToml;
 use crate::common::tables::{errors_and_rates, rates, sci_list, SYMMETRY_CHECKS};
 use peritherm::case::Case;
+use peritherm::error::CoreError;
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::solve::implicit::{Implicit, Options, Scheme};
@@ -28,7 +29,8 @@ fn steady(c: &Case) -> (Model, Vec<f64>) {
     let model = Model::build(&c.spec).unwrap();
     let mut st = Implicit::new(&model, Scheme::Bdf2, Options::default()).unwrap();
     let mut theta = model.theta0.clone();
-    st.steady(&mut theta, &[1.0], |_, _, _, _| Ok(())).unwrap();
+    st.steady(&mut theta, &[1.0], |_, _, _, _| Ok::<_, CoreError>(()))
+        .unwrap();
     (model, theta)
 }
 

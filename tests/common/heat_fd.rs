@@ -1,6 +1,6 @@
 //! Independent explicit finite-difference solves of θ_t = α∇²θ from a uniform θ0: a box of
 //! cells (2D or 3D, each face held at 0 or insulated) and a disc by radial finite volumes
-//! (edge held at 0). They check the series of `crates/core/src/analytic.rs` and share no peritherm code.
+//! (edge held at 0). They check the series of `crates/analytic` and share no peritherm code.
 
 /// A box [0, size_a] per axis split into `cells[a]` cells, each face held at 0 or insulated.
 pub struct BoxFd {

@@ -1,6 +1,6 @@
 //! The series references of the mesh-convergence suite (`box_fixed_faces`, `disc_fixed_edge`
-//! in crates/core/src/analytic.rs), and of the laser film and the split thermal shock (`film_laser_pulse`,
-//! `plate_pulse_split`), against independent finite-difference solves
+//! in crates/analytic/src/rect.rs and radial.rs), and of the laser film and the split thermal
+//! shock (`film_laser_pulse`, `plate_pulse_split`, crates/analytic/src/pulse.rs), against independent finite-difference solves
 //! (tests/common/heat_fd.rs).
 //!
 //! Tolerances: the finite differences are second order in h (mirrored ghosts at the faces,

@@ -1,20 +1,10 @@
-//! Typed errors of the library; the CLI turns them into one line each.
+//! Typed errors of the numerics; the layers above wrap them (`peritherm-io`'s and
+//! `peritherm-post`'s `Error::Core`) and the CLI turns each into one line.
 
-use std::path::PathBuf;
-
-/// Everything that can go wrong inside peritherm.
+/// Everything that can go wrong in the numerics: a model, expression, time step, state or
+/// linear solve that does not hold, or another rank that stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A case file that cannot be read, parsed or validated.
-    #[error("{file}: {key}: {message}")]
-    Case {
-        /// The case file.
-        file: PathBuf,
-        /// The offending key, dotted (e.g. `time.dt`).
-        key: String,
-        /// What is wrong and what is expected.
-        message: String,
-    },
     /// A model that is inconsistent although each key was valid.
     #[error("{key}: {message}")]
     Model {
@@ -58,34 +48,9 @@ pub enum Error {
         /// What failed and why.
         message: String,
     },
-    /// A mesh file that cannot be read or does not describe a usable body.
-    #[error("{path}: {message}")]
-    Mesh {
-        /// The mesh file.
-        path: PathBuf,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A plot whose data cannot be drawn (empty, non-finite, zero-size range) or whose
-    /// files cannot be written.
-    #[error("{path}: {message}")]
-    Plot {
-        /// The plot's file stem (`<stem>.png`, `<stem>.svg`).
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
-    /// Output could not be written.
-    #[error("{path}: {error}")]
-    Io {
-        /// The file or directory.
-        path: PathBuf,
-        /// The underlying error (shown in the message, so not chained as a source).
-        error: std::io::Error,
-    },
 }
 
-/// Result alias for the library.
+/// Result alias of the numerics.
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {

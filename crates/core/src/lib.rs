@@ -1,15 +1,15 @@
 //! peritherm-core: the numerics layer of peritherm — node clouds ([`cloud`]), horizons
 //! ([`neighbors`]), kernels ([`kernel`]), the dual-horizon operator ([`operator`],
 //! [`weights`], [`stencil`]), boundary conditions ([`bc`]), cracks ([`crack`]), materials
-//! ([`material`]), the model ([`model::ModelSpec`]), the time integrators ([`solve`]) and
-//! the analytic series ([`analytic`]), following `docs/theory.md`. It reads and writes no
-//! file and must not depend on file formats, plotting or the command line (no toml,
-//! serde_json, mshio, plotters, clap, indicatif, ctrlc or anyhow): the layers above it
-//! (`peritherm-fem`, `peritherm-io`, `peritherm-post`, `peritherm`) depend on it, never the
-//! other way round. Its [`Error`] is the error vocabulary of every layer.
+//! ([`material`]), the model ([`model::ModelSpec`]) and the time integrators ([`solve`]),
+//! following `docs/theory.md` (the analytic references are the crate `peritherm-analytic`).
+//! It reads and writes no file and must not depend on file formats, plotting or the command
+//! line (no toml, serde_json, mshio, plotters, clap, indicatif, ctrlc or anyhow): the layers
+//! above it (`peritherm-fem`, `peritherm-analytic`, `peritherm-io`, `peritherm-post`,
+//! `peritherm`) depend on it, never the other way round. Its [`Error`] holds the numerics'
+//! errors only; the layers above raise their own and wrap it.
 #![warn(missing_docs)]
 
-pub mod analytic;
 pub mod bc;
 pub mod budget;
 pub mod cloud;

@@ -562,12 +562,13 @@ impl Model {
     /// read but K): a case `check` refuses is refused in the time of a set-up without them.
     /// With [`Weights::Solve`] the model is the same bits as [`Model::build_with`]'s; with
     /// [`Weights::StoredOnly`] and nothing in `store`, K stays uncorrected and
-    /// [`Model::correction`] is None.
-    pub fn build_checked(
+    /// [`Model::correction`] is None. `check` may fail with the error of a layer above
+    /// (`E`, which holds this crate's [`Error`]); so may the build then.
+    pub fn build_checked<E: From<Error>>(
         spec: &ModelSpec,
         (store, weights): (Option<&dyn Store>, Weights),
-        check: impl Fn(&Model) -> Result<()>,
-    ) -> Result<Model> {
+        check: impl Fn(&Model) -> std::result::Result<(), E>,
+    ) -> std::result::Result<Model, E> {
         let bare = ModelSpec {
             consistency: Order::None,
             ..spec.clone()

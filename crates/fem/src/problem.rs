@@ -56,9 +56,9 @@ pub struct FemProblem<'a> {
     pub end: f64,
     /// Mesh and time settings.
     pub options: &'a FemOptions,
-    /// Reads the element mesh file of [`FemOptions::mesh`] (the IO layer's gmsh reader): the
-    /// FEM reads no file itself.
-    pub read_mesh: &'a dyn Fn(&Path) -> Result<Mesh>,
+    /// Reads the element mesh file of [`FemOptions::mesh`] (the IO layer's gmsh reader; its
+    /// error as the reader's one-line message): the FEM reads no file itself.
+    pub read_mesh: &'a dyn Fn(&Path) -> std::result::Result<Mesh, String>,
 }
 
 /// Default step: min(end/1000, first output/100), s. The case's `time.dt` is the explicit PD
@@ -73,7 +73,7 @@ pub fn default_dt(problem: &FemProblem) -> f64 {
 /// empty, which is an error unless the case leaves it free and no crack uses it).
 fn other_mesh(problem: &FemProblem, g: &MeshGeometry, file: &Path) -> Result<FemMesh> {
     let key = "reference.fem.mesh";
-    let other = (problem.read_mesh)(file).map_err(|e| Error::model(key, e.to_string()))?;
+    let other = (problem.read_mesh)(file).map_err(|e| Error::model(key, e))?;
     let name_of = |m: &Mesh, gr: usize| m.groups[gr].name.clone();
     let mut regions = Vec::with_capacity(g.regions.len());
     for r in &g.regions {

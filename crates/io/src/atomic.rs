@@ -1,7 +1,7 @@
 //! Atomic file writes ([`write_atomic`]) under the lock ([`writing`]) that the interrupt
 //! handler ([`crate::staging::interrupt`]) takes, so that no output file is cut in half.
 
-use peritherm_core::error::{Error, Result};
+use crate::error::{Error, Result};
 use std::path::Path;
 use std::sync::{Mutex, MutexGuard};
 

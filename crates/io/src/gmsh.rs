@@ -15,7 +15,7 @@ use std::path::Path;
 
 use mshio::{ElementType, MshFile, MshParserError};
 
-use peritherm_core::error::{Error, Result};
+use crate::error::{Error, Result};
 use peritherm_core::math::Point;
 use peritherm_core::mesh::{integrity, Element, ElementKind, Group, Mesh};
 

@@ -9,9 +9,9 @@
 //! analytical reference (tables and the FEM are fields at the output times only).
 
 use crate::atomic::write_atomic;
-use peritherm_core::analytic::Reference;
+use crate::error::{Error, Result};
+use peritherm_analytic::Reference;
 use peritherm_core::cloud::Cloud;
-use peritherm_core::error::{Error, Result};
 use peritherm_core::math::Point;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

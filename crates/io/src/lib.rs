@@ -9,6 +9,7 @@
 
 pub mod atomic;
 pub mod case;
+pub mod error;
 pub mod gmsh;
 pub mod history;
 pub mod output;
@@ -17,3 +18,5 @@ pub mod reference;
 pub mod series;
 pub mod staging;
 pub mod weights_cache;
+
+pub use error::{Error, Result};

@@ -10,8 +10,8 @@
 //! ([`crate::provenance`]).
 
 use crate::atomic::write_atomic;
+use crate::error::{Error, Result};
 use peritherm_core::cloud::Cloud;
-use peritherm_core::error::{Error, Result};
 use peritherm_core::math::{Point, Vector};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

@@ -6,8 +6,8 @@
 
 use crate::atomic::write_atomic;
 use crate::case::Case;
+use crate::error::{Error, Result};
 use crate::output::{CaseOrigin, FileStamp, RunSummary};
-use peritherm_core::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// File name of the case copy in a run's directory.

@@ -6,7 +6,7 @@
 //! row per point and output time. Units as the case (s, m, °C). Lines starting with `#` are
 //! comments.
 
-use peritherm_core::error::{Error, Result};
+use crate::error::{Error, Result};
 use peritherm_core::math::Point;
 use std::path::{Path, PathBuf};
 

@@ -2,9 +2,9 @@
 //! every length, diffusivity and material constant a positive number, and the relations
 //! between parameters each series needs. It names parameters by their serialised (case-file)
 //! keys, so it lives in the IO layer (serde_json) rather than beside the series in
-//! [`peritherm_core::analytic`].
+//! [`peritherm_analytic`].
 
-use peritherm_core::analytic::Reference;
+use peritherm_analytic::Reference;
 
 /// Checks a series' parameters before it is evaluated.
 pub trait SeriesCheck {
@@ -126,7 +126,7 @@ fn positive(name: &str, v: f64) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use peritherm_core::analytic::AxisEnds;
+    use peritherm_analytic::AxisEnds;
 
     /// Box and disc parameters that no series has are named.
     #[test]

@@ -11,8 +11,8 @@
 //! An existing `--out` is only replaced when it holds nothing but peritherm output.
 
 use crate::atomic::writing;
+use crate::error::{Error, Result};
 use crate::output::Unfinished;
-use peritherm_core::error::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard};
@@ -48,8 +48,16 @@ fn is_ours(name: &str) -> bool {
 
 /// Runs `write` into a staged copy of `out` for the run of `case` and swaps it in when it
 /// succeeds; a failure after something was written leaves a run.json saying so, a refusal
-/// before anything was written leaves `out` as it was.
-pub fn write_into<T>(out: &Path, case: &str, write: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
+/// before anything was written leaves `out` as it was. `write` may fail with the error of
+/// any layer above this one (`E`), which holds this layer's.
+pub fn write_into<T, E>(
+    out: &Path,
+    case: &str,
+    write: impl FnOnce(&Path) -> std::result::Result<T, E>,
+) -> std::result::Result<T, E>
+where
+    E: From<Error> + std::fmt::Display,
+{
     let staged = Staged::begin(out, case)?;
     match write(staged.dir()) {
         Ok(value) => {

@@ -5,6 +5,9 @@
 //! (`peritherm`: clap, indicatif, ctrlc, anyhow), and nothing below it depends on it.
 #![warn(missing_docs)]
 
+pub mod error;
 pub mod figures;
 pub mod plot;
 pub mod report;
+
+pub use error::{Error, Result};

@@ -2,7 +2,7 @@
 //! implicit), and [`integrate`], the loop over the output times for every [`Schedule`] (fixed
 //! steps through [`march`], adaptive ones through the implicit stepper's own control).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::operator::Conductance;
 use crate::solve::enthalpy::Enthalpic;
@@ -97,16 +97,17 @@ impl Schedule {
 /// The time loop of a run from `theta` (every node, °C) at `t0` (s) through `outputs` (s):
 /// fixed steps through [`march`], or the implicit stepper's steady solve or adaptive steps.
 /// Calls `on_output(k, t, θ, K, E)` at each output (K in W/K, E the body's energy in J) and
-/// `progress(steps, t)` now and then (t in s).
-pub fn integrate(
+/// `progress(steps, t)` now and then (t in s). `on_output` may fail with the error of a
+/// layer above (`E`, which holds this crate's [`Error`]); the loop then stops with it.
+pub fn integrate<E: From<Error>>(
     engine: &mut Engine<'_>,
     schedule: &Schedule,
     theta: &mut [f64],
     t0: f64,
     outputs: &[f64],
-    mut on_output: impl FnMut(usize, f64, &[f64], &Conductance, f64) -> Result<()>,
+    mut on_output: impl FnMut(usize, f64, &[f64], &Conductance, f64) -> std::result::Result<(), E>,
     mut progress: impl FnMut(u64, f64),
-) -> Result<RunStats> {
+) -> std::result::Result<RunStats, E> {
     if let Engine::Implicit(im) = engine {
         let model = im.model();
         let mut linear = |k: usize, t: f64, th: &[f64], c: &Conductance| {

@@ -118,15 +118,15 @@ pub fn first_non_finite(
 /// output time (s), a NaN check every 4096 steps and at every output, where
 /// `at_output(stepper, k, t, θ)` is called; `progress(steps)` every
 /// [`Stepper::report_every`] steps and at the end. The caller has begun the stepper.
-pub fn march<S: Stepper + ?Sized>(
+pub fn march<S: Stepper + ?Sized, E: From<Error>>(
     stepper: &mut S,
     theta: &mut [f64],
     t0: f64,
     dt: f64,
     outputs: &[f64],
-    mut at_output: impl FnMut(&mut S, usize, f64, &[f64]) -> Result<()>,
+    mut at_output: impl FnMut(&mut S, usize, f64, &[f64]) -> std::result::Result<(), E>,
     mut progress: impl FnMut(u64),
-) -> Result<RunStats> {
+) -> std::result::Result<RunStats, E> {
     stepper.check_dt(dt)?;
     let every = stepper.report_every();
     let mut t = t0;

@@ -1,9 +1,9 @@
 //! The body: `dimension`, `symmetry`, `[domain]` or `[mesh]`, and the `[[region]]` entries.
 
 use super::{CaseFile, Ctx};
+use crate::error::Result;
 use peritherm_core::cloud::mesh::{MeshGeometry, MeshRegion};
 use peritherm_core::cloud::{BoxGeometry, BoxRegion, HorizonRule, FACE_NAMES};
-use peritherm_core::error::Result;
 use peritherm_core::material::Material;
 use peritherm_core::model::Geometry;
 use peritherm_core::symmetry::Symmetry;

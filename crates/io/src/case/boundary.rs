@@ -3,10 +3,10 @@
 //! missing required one a missing field, both reported by serde; `method` is an enum per type.
 
 use super::{named, Ctx, ValueSpec};
+use crate::error::Result;
 use peritherm_core::bc::{FaceBc, Layer};
 use peritherm_core::cloud::mesh::{MeshGeometry, UNNAMED};
 use peritherm_core::cloud::FACE_NAMES;
-use peritherm_core::error::Result;
 use peritherm_core::model::{Crack, CrackShape, Geometry};
 use serde::Deserialize;
 use std::collections::BTreeMap;

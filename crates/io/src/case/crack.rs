@@ -2,9 +2,9 @@
 //! optionally growing along the polyline.
 
 use super::Ctx;
+use crate::error::Result;
 use peritherm_core::bc::FaceBc;
 use peritherm_core::crack::Growth;
-use peritherm_core::error::Result;
 use peritherm_core::math::Point;
 use peritherm_core::model::{Crack, CrackShape, Geometry};
 use serde::Deserialize;

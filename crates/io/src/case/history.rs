@@ -1,8 +1,8 @@
 //! `[history]`: temperature histories at points.
 
 use super::Ctx;
+use crate::error::Result;
 use crate::history::{HistoryPlot, HistorySpec};
-use peritherm_core::error::Result;
 use peritherm_core::limits::{MAX_HISTORY_POINTS, MAX_HISTORY_ROWS};
 use peritherm_core::solve::Integrator;
 use serde::Deserialize;

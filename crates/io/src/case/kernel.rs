@@ -1,7 +1,7 @@
 //! `[kernel]` and the `[material.<name>]` tables.
 
 use super::Ctx;
-use peritherm_core::error::Result;
+use crate::error::Result;
 use peritherm_core::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use peritherm_core::material::{BondRule, Material};
 use peritherm_core::symmetry::Symmetry;

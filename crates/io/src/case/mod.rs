@@ -24,8 +24,8 @@ pub use kernel::KernelSpec;
 pub use reference::{FemReferenceSpec, ReferenceSection, ReferenceSource, ReferenceSpec};
 pub use time::{InitialSpec, SourceSpec, TimeSpec};
 
+use crate::error::{CoreError, Error, Result};
 use crate::history::HistorySpec;
-use peritherm_core::error::{Error, Result};
 use peritherm_core::expr::Expr;
 use peritherm_core::material::Material;
 use peritherm_core::math::Point;
@@ -138,7 +138,7 @@ impl Case {
 
     /// A library error keyed to this case file: a model error's key becomes a key of the
     /// file; every other error is returned as it is.
-    pub fn keyed(&self, e: Error) -> Error {
+    pub fn keyed(&self, e: impl Into<Error>) -> Error {
         Ctx::new(&self.path).keyed(e)
     }
 
@@ -283,9 +283,9 @@ impl<'a> Ctx<'a> {
     }
 
     /// A model error's key becomes a key of the case file; other errors pass unchanged.
-    fn keyed(&self, e: Error) -> Error {
-        match e {
-            Error::Model { key, message } => self.err(key, message),
+    fn keyed(&self, e: impl Into<Error>) -> Error {
+        match e.into() {
+            Error::Core(CoreError::Model { key, message }) => self.err(key, message),
             other => other,
         }
     }

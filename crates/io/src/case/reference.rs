@@ -1,10 +1,10 @@
 //! `[reference]`: the classical solution a run is compared with, and where.
 
 use super::Ctx;
+use crate::error::Result;
 use crate::reference::ReferenceTable;
 use crate::series::SeriesCheck;
-use peritherm_core::analytic::Reference;
-use peritherm_core::error::Result;
+use peritherm_analytic::Reference;
 use peritherm_core::limits::MAX_HISTORY_POINTS;
 use peritherm_core::math::Point;
 use peritherm_fem::{FemOptions, Scheme};
@@ -68,7 +68,7 @@ pub struct FemReferenceSpec {
 /// Where the classical temperatures of a reference come from.
 #[derive(Debug, Clone)]
 pub enum ReferenceSource {
-    /// An analytical series of [`peritherm_core::analytic`].
+    /// An analytical series of [`peritherm_analytic`].
     Analytic(Reference),
     /// A table exported by another code, interpolated at the nodes.
     Table(Arc<ReferenceTable>),

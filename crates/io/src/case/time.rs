@@ -1,7 +1,7 @@
 //! `[initial]`, `[source]` and `[time]`.
 
 use super::{Ctx, ValueSpec};
-use peritherm_core::error::Result;
+use crate::error::Result;
 use peritherm_core::expr::Expr;
 use peritherm_core::material::Material;
 use peritherm_core::model::Initial;

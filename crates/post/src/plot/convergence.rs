@@ -6,7 +6,7 @@ use super::{
     draw_legend, extent, palette, plot_error, render, sci, titled_chart, Chart, DrawError, Figure,
     Labels, Legend, Series,
 };
-use peritherm_core::error::{Error, Result};
+use crate::error::{CoreError, Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -89,7 +89,7 @@ pub fn convergence_plot(
             let (xs, ys): (Vec<f64>, Vec<f64>) = s.points.iter().copied().unzip();
             fit_power_law(&xs, &ys).map_err(|e| {
                 let msg = match e {
-                    Error::Model { message, .. } => message,
+                    Error::Core(CoreError::Model { message, .. }) => message,
                     e => e.to_string(),
                 };
                 plot_error(stem, format!("series `{}`: {msg}", s.name))

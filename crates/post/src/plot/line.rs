@@ -4,7 +4,7 @@ use super::{
     axis_ticks, draw_legend, extent, palette, plot_error, render, titled_chart, DrawError, Figure,
     Labels, FONT,
 };
-use peritherm_core::error::Result;
+use crate::error::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;

@@ -4,7 +4,7 @@
 use super::{
     axis_ticks, extent, plot_error, render, widen, Chart, ColourMap, DrawError, Figure, FONT,
 };
-use peritherm_core::error::Result;
+use crate::error::Result;
 use peritherm_core::math::{Point, Vector};
 use peritherm_core::spatial::PointIndex;
 use plotters::coord::Shift;

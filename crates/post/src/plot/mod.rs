@@ -14,7 +14,7 @@ pub use convergence::{convergence_plot, fit_power_law, fit_rate, PowerLaw};
 pub use line::{line_plot, Legend, Series, Style};
 pub use map::{field_map, isoline, FieldMap, IRREGULAR_SQUARE};
 
-use peritherm_core::error::{Error, Result};
+use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;

@@ -3,9 +3,9 @@
 
 pub mod page;
 
+use crate::error::{Error, IoError, Result};
 use peritherm_core::cloud::Cloud;
 use peritherm_core::crack::Cutter;
-use peritherm_core::error::{Error, Result};
 use peritherm_core::math::Point;
 use peritherm_core::spatial::PointIndex;
 use peritherm_io::case::{ReferenceSource, ReferenceSpec};
@@ -38,7 +38,7 @@ pub fn classical_at(
                 values[i], p.x, p.y, p.z
             );
             Err(match source {
-                ReferenceSource::Table(_) => Error::Case { file, key, message },
+                ReferenceSource::Table(_) => IoError::Case { file, key, message }.into(),
                 _ => Error::model(key, message),
             })
         }
@@ -60,10 +60,12 @@ fn classical_values(
             "the FEM reference is solved (run::resolve_reference) before it is compared",
         )),
         ReferenceSource::Table(table) => {
-            let bad = |message: String| Error::Case {
-                file: table.path.clone(),
-                key: format!("t = {t}"),
-                message,
+            let bad = |message: String| {
+                Error::Io(IoError::Case {
+                    file: table.path.clone(),
+                    key: format!("t = {t}"),
+                    message,
+                })
             };
             let snap = table
                 .at(t)
@@ -299,7 +301,7 @@ fn fit_at(dim: usize, x: &Point, near: &[(usize, f64)], b: (&[Point], &[f64])) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use peritherm_core::analytic::Reference;
+    use peritherm_analytic::Reference;
 
     /// PCS2022, eq. 27 by its definition: a field off the reference by
     /// the same d at every node has rms d, so ε = d / max |T_ref| whatever the field; a difference

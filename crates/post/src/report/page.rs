@@ -2,11 +2,11 @@
 //! error along them, maps of temperature (and damage and heat flux for cracked bodies), and
 //! `report.md` plus `index.html` showing them with the metrics and the run's settings.
 
+use crate::error::{IoError, Result};
 use crate::plot::{
     field_map, isoline, line_plot, ColourMap, FieldMap, Labels, Legend, Series, Style,
 };
 use peritherm_core::crack::segments_at;
-use peritherm_core::error::Result;
 use peritherm_core::math::Point;
 use peritherm_core::model::crack_cutters;
 use peritherm_io::atomic::write_atomic;
@@ -287,14 +287,14 @@ pub fn write_report(
     reference_name: &str,
     extra: Option<(&Path, &str)>,
 ) -> Result<Written> {
-    std::fs::create_dir_all(dir).map_err(|error| peritherm_core::error::Error::Io {
+    std::fs::create_dir_all(dir).map_err(|error| IoError::Io {
         path: dir.to_path_buf(),
         error,
     })?;
     let summary = RunSummary::read(run)?;
     let fields = (0..summary.fields.len())
         .map(|k| summary.read_field(run, k))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<peritherm_io::Result<Vec<_>>>()?;
     let dim = case.spec.geometry.bare_cloud()?.dim;
     let extra = match extra {
         Some((d, name)) => Some(ExtraRun::read(d, name, &summary)?),
@@ -720,7 +720,7 @@ pub fn write_index(dir: &Path, reports: &[Written]) -> Result<()> {
     }
     html.push_str("</table>\n</body></html>\n");
     write_atomic(&dir.join("report.md"), md.as_bytes())?;
-    write_atomic(&dir.join("index.html"), html.as_bytes())
+    Ok(write_atomic(&dir.join("index.html"), html.as_bytes())?)
 }
 
 /// HTML-escapes text.

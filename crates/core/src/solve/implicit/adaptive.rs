@@ -329,21 +329,22 @@ impl Implicit<'_> {
     /// one rung after two steps); on rejection it drops as many rungs as the ideal asks (at
     /// least one, at most five) and retries from the same state. The first step is the
     /// largest rung not above `first`. The last step may pass the last output time.
-    pub fn run_adaptive(
+    pub fn run_adaptive<E: From<Error>>(
         &mut self,
         theta: &mut [f64],
         t0: f64,
         adaptive: &Adaptive,
         outputs: &[f64],
-        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> std::result::Result<(), E>,
         mut progress: impl FnMut(u64, f64),
-    ) -> Result<RunStats> {
+    ) -> std::result::Result<RunStats, E> {
         let tol = adaptive.tolerance;
         if !(tol.is_finite() && tol > 0.0) {
             return Err(Error::model(
                 "time.tolerance",
                 format!("must be a positive number, got {tol}"),
-            ));
+            )
+            .into());
         }
         let Some(&t_last) = outputs.last() else {
             return Ok(RunStats::default());
@@ -353,7 +354,8 @@ impl Implicit<'_> {
             return Err(Error::model(
                 "time.dt_max",
                 format!("must be a positive number, got {top}"),
-            ));
+            )
+            .into());
         }
         let first = self.begin_adaptive(theta, t0, tol, adaptive.first, t_last)?;
         let mut ladder = Ladder::new(top, first);
@@ -377,7 +379,7 @@ impl Implicit<'_> {
                         past.t,
                         crate::limits::MAX_STEPS
                     ),
-                ));
+                ).into());
             }
             if ladder.k > MAX_RUNG {
                 return Err(Error::Solver {
@@ -386,7 +388,7 @@ impl Implicit<'_> {
                         ladder.rung(MAX_RUNG),
                         past.t
                     ),
-                });
+                }.into());
             }
             let h = ladder.rung(ladder.k);
             let (est, p) = self.attempt(&past, h)?;

@@ -2,7 +2,7 @@
 
 use super::adaptive::Past;
 use super::Implicit;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::operator::Conductance;
 
 impl Implicit<'_> {
@@ -36,15 +36,15 @@ impl Implicit<'_> {
     /// Calls `on_output(k, t, θ, K)` for the outputs from `next` on that the accepted step
     /// of length `h` (s) reaching `past.t` covers, with θ from its Hermite interpolant; returns
     /// the next output not reached.
-    pub(super) fn dense_outputs(
+    pub(super) fn dense_outputs<E: From<Error>>(
         &mut self,
         theta: &mut [f64],
         past: &Past,
         h: f64,
         outputs: &[f64],
         mut next: usize,
-        on_output: &mut impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
-    ) -> Result<usize> {
+        on_output: &mut impl FnMut(usize, f64, &[f64], &Conductance) -> std::result::Result<(), E>,
+    ) -> std::result::Result<usize, E> {
         while next < outputs.len() && outputs[next] <= past.t + 1e-12 * h {
             let to = outputs[next];
             let s = ((to - past.t_prev) / h).clamp(0.0, 1.0);

@@ -2,7 +2,7 @@
 
 use super::linear::Guess;
 use super::{refuse, Implicit};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::operator::Conductance;
 use crate::solve::exchange::Reduce;
 use crate::solve::stepper::RunStats;
@@ -29,12 +29,12 @@ impl Implicit<'_> {
 
     /// Steady state `A θ = f(t)` with each output time's boundary data and loads, calling
     /// `on_output(k, t, θ, K)` for each (theory §4).
-    pub fn steady(
+    pub fn steady<E: From<Error>>(
         &mut self,
         theta: &mut [f64],
         outputs: &[f64],
-        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> Result<()>,
-    ) -> Result<RunStats> {
+        mut on_output: impl FnMut(usize, f64, &[f64], &Conductance) -> std::result::Result<(), E>,
+    ) -> std::result::Result<RunStats, E> {
         self.level_fixed()?;
         for (k, &t) in outputs.iter().enumerate() {
             self.sys.forcing(
