@@ -343,7 +343,7 @@ const ROW_BYTES: usize = 8 + 8 + 8 + 1 + 16;
 
 /// Bytes one forward-Euler step moves between memory and the cores, each array counted once
 /// (the neighbours' θ_j are reused from cache in space-filling-curve order): the rows'
-/// [`ROW_BYTES`], and K as the kernel reads it. CSR: a u64 offset per row, a u32 column and
+/// bytes (41 per row), and K as the kernel reads it. CSR: a u64 offset per row, a u32 column and
 /// an f64 K_ij per bond; stencils (`stencil_bytes` held): a u16 stencil index per row and the
 /// stencils themselves, B.
 pub fn streamed_bytes(model: &Model, stencil_bytes: Option<usize>) -> f64 {
