@@ -5,7 +5,8 @@
 //! one forward-Euler step on free plates (2D m = 3, 2D m = 6.5, 3D m = 3) through the CSR rows
 //! and the stencils of K, each step after a read-only pass on the same threads (the machine may
 //! be shared: both see the same load), the time of the neighbour search and of the assembly of
-//! K, and the bytes held and streamed per bond. Every figure is the median of repeated timings; nothing is estimated.
+//! K, and the bytes held and streamed per bond. Every figure is the median of repeated
+//! timings; nothing is estimated.
 
 use crate::case::Case;
 use crate::error::{Error, Result};
