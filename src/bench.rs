@@ -325,13 +325,10 @@ integrator = "euler"
     Ok(Case::parse(&text, Path::new("bench.toml"))?)
 }
 
-/// Bytes held by the bond data of a model (neighbour lists and K), B.
+/// Bytes held by the bond data of a model (K, and what the damage of cracks needs), B.
 pub fn bond_bytes(model: &Model) -> usize {
-    let h = &model.horizons;
     let k = &model.conductance;
-    h.offsets.capacity() * 8
-        + h.targets.capacity() * 4
-        + h.beta.capacity() * 8
+    model.damage.as_ref().map_or(0, |d| d.bytes())
         + k.offsets.capacity() * 8
         + k.cols.capacity() * 4
         + k.vals.capacity() * 8

@@ -727,7 +727,7 @@ fn check(path: &std::path::Path, options: &peritherm::prepare::Options) -> anyho
         case.path.display(),
         model.cloud.n_body,
         model.cloud.n_fictitious(),
-        model.horizons.n_bonds()
+        model.bonds
     );
     let euler = Integrator::Euler.stable_dt(&model);
     match (case.integrator.is_implicit(), plan.adaptive) {

@@ -262,12 +262,7 @@ fn regions_have_nodes(case: &Case, model: &Model) -> Result<()> {
 
 /// The body nodes of the model's rows without a bond: how many, and the first.
 fn lonely(model: &Model) -> (usize, Option<usize>) {
-    let mut nodes = model
-        .rows
-        .clone()
-        .filter(|&i| model.horizons.row(i).is_empty());
-    let first = nodes.next();
-    (first.map_or(0, |_| 1 + nodes.count()), first)
+    (model.bondless.len(), model.bondless.first().copied())
 }
 
 /// Refuses `count` body nodes without a bond, the first of them `first`.

@@ -1,6 +1,6 @@
 //! Running a case end to end: build, integrate, write fields and the summary.
 
-use crate::atomic::write_atomic;
+use crate::atomic::{write_atomic, write_atomic_with};
 use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::crack::tips_at;
 use crate::error::{CoreError, Error, IoError, Result};
@@ -154,7 +154,7 @@ fn output_fields(
             q[axis] = *p;
         }
     }
-    if !model.crack_cuts.mu.is_empty() {
+    if model.damage.is_some() {
         // without cracks the damage is 0 everywhere, on every rank alike
         let n = damage.len();
         part[..n].copy_from_slice(&damage);
@@ -205,13 +205,24 @@ fn follow(case: &Case, model: &Model, plan: Plan, rank: &Rank) -> Result<()> {
         },
         |_, _| {},
     )?;
-    ranks(model, rank);
+    ranks(case, model, rank);
     Ok(())
+}
+
+/// Directed bonds of the body rows `rows` and from fictitious nodes into them: the model's own
+/// count when it holds just those rows (a share), else counted by a search of those rows (a
+/// whole model stepped in shares; the model keeps no neighbour lists).
+fn bonds_of(case: &Case, model: &Model, rows: std::ops::Range<usize>) -> usize {
+    if rows == model.rows {
+        return model.bonds;
+    }
+    let census = crate::neighbors::Horizons::census(&model.cloud, &case.spec.kernel, &[rows]);
+    census[0].bonds
 }
 
 /// Per-rank sizes of a distributed run for run.json: the last collective of a run, which
 /// rank 0 calls after its time loop and the others at the end of [`follow`].
-fn ranks(model: &Model, rank: &Rank) -> Ranks {
+fn ranks(case: &Case, model: &Model, rank: &Rank) -> Ranks {
     let ex = rank.exchange;
     let exchange_seconds = ex.reduce(ex.exchange_seconds(), Reduce::Max);
     let rows = ex.rows();
@@ -221,7 +232,7 @@ fn ranks(model: &Model, rank: &Rank) -> Ranks {
         all.into_iter().map(|v| v as usize).collect()
     };
     let ghosts = each(ex.plan().halo.ghosts());
-    let bonds = each(model.bonds_into(rows.clone()));
+    let bonds = each(bonds_of(case, model, rows.clone()));
     Ranks {
         size: ex.size(),
         mode: rank.mode.into(),
@@ -303,7 +314,7 @@ fn execute(
     )
     .map_err(|e| run_error(case, model, e))?;
     // the last collective: whatever fails below fails on rank 0 alone
-    let ranks = rank.map(|r| ranks(model, r));
+    let ranks = rank.map(|r| ranks(case, model, r));
     let history = recorder.as_ref().map(|r| r.write(out)).transpose()?;
     let timing = Timing {
         setup_seconds,
@@ -412,7 +423,7 @@ fn summary(
         solver: "peridynamics".into(),
         nodes: model.cloud.n_body,
         fictitious_nodes: model.cloud.n_fictitious(),
-        bonds: model.horizons.n_bonds(),
+        bonds: model.bonds,
         pairs: model.conductance.nnz(),
         steps: stats.steps,
         // implicit runs: the step taken (adaptive: the first; 0 for steady) and, for
@@ -560,7 +571,7 @@ impl<'a> OutputWriter<'a> {
             flux,
             reference: classical.as_deref(),
         };
-        write_atomic(&path, field_csv(&model.cloud, &f).as_bytes())?;
+        write_atomic_with(&path, |w| field_csv(w, &model.cloud, &f))?;
         let vtk = self.write_vtk(k + 1, &f)?;
         self.series.push((t, vtk));
         write_atomic(&pvd_path(out), series_pvd(&self.series).as_bytes())?;
@@ -580,7 +591,7 @@ impl OutputWriter<'_> {
     fn write_vtk(&self, k: usize, f: &Fields) -> Result<String> {
         let (cloud, out) = (&self.model.cloud, self.out);
         if self.pieces.is_empty() {
-            write_atomic(&vtu_path(out, k), field_vtu(cloud, f).as_bytes())?;
+            write_atomic_with(&vtu_path(out, k), |w| field_vtu(w, cloud, f))?;
             return Ok(format!("field_{k}.vtu"));
         }
         let dir = piece_path(out, k, 0);
@@ -591,8 +602,8 @@ impl OutputWriter<'_> {
         })?;
         let mut names = Vec::with_capacity(self.pieces.len());
         for (r, rows) in self.pieces.iter().enumerate() {
-            let piece = field_vtu_rows(cloud, f, rows.clone());
-            write_atomic(&piece_path(out, k, r), piece.as_bytes())?;
+            let piece = |w: &mut dyn std::io::Write| field_vtu_rows(w, cloud, f, rows.clone());
+            write_atomic_with(&piece_path(out, k, r), piece)?;
             names.push(format!("field_{k}/piece_{r}.vtu"));
         }
         let pvtu = field_pvtu(&names, f.reference.is_some());

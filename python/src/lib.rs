@@ -339,6 +339,11 @@ struct PyModel {
 }
 
 impl PyModel {
+    /// The model's directed neighbour lists, searched anew (the model does not keep them).
+    fn horizons(&self) -> peritherm::neighbors::Horizons {
+        peritherm::neighbors::Horizons::build(&self.model.cloud, &self.case.spec.kernel)
+    }
+
     /// Builds the model of `case` as a run does (budget, model, semantic checks, plan).
     fn build(case: Arc<Case>, max_memory: Option<f64>) -> peritherm::Result<Self> {
         let options = run_options(max_memory)?;
@@ -455,7 +460,7 @@ impl PyModel {
     /// Directed bonds (entries of `neighbor_indices`).
     #[getter]
     fn n_bonds(&self) -> usize {
-        self.model.horizons.n_bonds()
+        self.model.bonds
     }
 
     /// Node positions, m: float64 (n_nodes, 3), a copy.
@@ -491,29 +496,19 @@ impl PyModel {
 
     /// Neighbour lists (CSR) row offsets: int64 (rows + 1,); row i holds the bonds
     /// `neighbor_indices[offsets[i]:offsets[i+1]]` of node i (rows: every node with bonds,
-    /// body first).
+    /// body first). The model keeps no neighbour lists once K is assembled: each call
+    /// searches them again (about a second per 10⁶ nodes).
     #[getter]
     fn neighbor_offsets<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let o: Vec<i64> = self
-            .model
-            .horizons
-            .offsets
-            .iter()
-            .map(|&v| v as i64)
-            .collect();
+        let o: Vec<i64> = self.horizons().offsets.iter().map(|&v| v as i64).collect();
         PyArray1::from_vec(py, o)
     }
 
-    /// Neighbour lists (CSR) targets: int64 (n_bonds,), node indices into the per-node arrays.
+    /// Neighbour lists (CSR) targets: int64 (n_bonds,), node indices into the per-node arrays
+    /// (searched again on each call, as `neighbor_offsets`).
     #[getter]
     fn neighbor_indices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let t: Vec<i64> = self
-            .model
-            .horizons
-            .targets
-            .iter()
-            .map(|&v| v as i64)
-            .collect();
+        let t: Vec<i64> = self.horizons().targets.iter().map(|&v| v as i64).collect();
         PyArray1::from_vec(py, t)
     }
 
@@ -659,7 +654,7 @@ impl PyModel {
             self.case.path.display().to_string(),
             self.model.cloud.n_body,
             self.model.cloud.n_fictitious(),
-            self.model.horizons.n_bonds()
+            self.model.bonds
         )
     }
 }
@@ -689,7 +684,7 @@ fn write_recorded(
             solver: "peridynamics".into(),
             nodes: model.cloud.n_body,
             fictitious_nodes: model.cloud.n_fictitious(),
-            bonds: model.horizons.n_bonds(),
+            bonds: model.bonds,
             pairs: model.conductance.nnz(),
             steps,
             dt: if dt.is_finite() { dt } else { 0.0 },

@@ -5,7 +5,7 @@
 
 use super::problem::{budget, default_dt, steps_for, FemModel, FemOptions, FemProblem};
 use super::solve::{Scheme, Stepper};
-use crate::atomic::write_atomic;
+use crate::atomic::write_atomic_with;
 use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::cloud::Cloud;
 use crate::crack::Cutter;
@@ -204,8 +204,8 @@ fn run_outputs<P: FnMut(u64, u64)>(
 /// Writes `field_<k>.csv` and `field_<k>.vtu` of output `k` (from 1) into `out`; returns
 /// the CSV's name.
 fn write_field(out: &Path, k: usize, cloud: &Cloud, f: &Fields) -> Result<String> {
-    write_atomic(&field_path(out, k), field_csv(cloud, f).as_bytes())?;
-    write_atomic(&vtu_path(out, k), field_vtu(cloud, f).as_bytes())?;
+    write_atomic_with(&field_path(out, k), |w| field_csv(w, cloud, f))?;
+    write_atomic_with(&vtu_path(out, k), |w| field_vtu(w, cloud, f))?;
     Ok(format!("field_{k}.csv"))
 }
 

@@ -74,7 +74,7 @@ pub fn same_as_serial(case: &Case, model: &Model, serial_dir: &Path, serial_seco
         let setup = if shares(case) { "share" } else { "whole" };
         assert_eq!(r.setup, setup, "{}", case.path.display());
         // the shares' bonds add up to the whole model's
-        assert_eq!(r.bonds.iter().sum::<usize>(), model.horizons.n_bonds());
+        assert_eq!(r.bonds.iter().sum::<usize>(), model.bonds);
         assert_eq!((s.bonds, s.pairs), (serial.bonds, serial.pairs));
         let what = format!(
             "{} on {ranks} ranks ({}, {setup})",

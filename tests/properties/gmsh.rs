@@ -86,7 +86,7 @@ fn groups_and_boundary_elements() {
     assert_eq!(names(&square, 2), ["plate"]);
     let on_side = |m: &Mesh, name: &str, coord: usize, value: f64| {
         let g = m.group(1, name).expect("side group") as u16;
-        let sides: Vec<_> = m.elements.iter().filter(|e| e.groups == [g]).collect();
+        let sides: Vec<_> = m.elements.iter().filter(|e| *e.groups == [g]).collect();
         assert!(!sides.is_empty(), "{name}");
         for e in sides {
             assert_eq!(e.kind, ElementKind::Line);
@@ -100,7 +100,7 @@ fn groups_and_boundary_elements() {
         on_side(mesh, "left", 0, 0.0);
         let plate = mesh.group(2, "plate").expect("plate");
         let body = mesh.elements.iter().filter(|e| e.kind.dim() == 2);
-        assert!(body.clone().all(|e| e.groups == [plate as u16]));
+        assert!(body.clone().all(|e| *e.groups == [plate as u16]));
     }
     assert_eq!(count(&load("square_quad.msh"), ElementKind::Line, "top"), 8);
 
@@ -111,7 +111,7 @@ fn groups_and_boundary_elements() {
     );
     for (name, x) in [("left", 0.0), ("right", 1.0)] {
         let g = line.group(0, name).expect("end group") as u16;
-        let ends: Vec<_> = line.elements.iter().filter(|e| e.groups == [g]).collect();
+        let ends: Vec<_> = line.elements.iter().filter(|e| *e.groups == [g]).collect();
         assert_eq!(ends.len(), 1, "{name}");
         assert_eq!(ends[0].kind, ElementKind::Point);
         assert_eq!(line.corners(ends[0])[0].x, x, "{name}");

@@ -61,9 +61,10 @@ fn energy_is_conserved_with_dual_horizon() {
 /// directed bonds really are asymmetric (some j ∈ H_i with i ∉ H_j).
 #[test]
 fn conductance_is_symmetric_and_bonds_are_directed() {
-    let model = Model::build(&dual_horizon_case("", "lattice").spec).unwrap();
+    let spec = dual_horizon_case("", "lattice").spec;
+    let model = Model::build(&spec).unwrap();
     let k = &model.conductance;
-    let h = &model.horizons;
+    let h = &peritherm::neighbors::Horizons::build(&model.cloud, &spec.kernel);
     let mut one_way = 0;
     for i in 0..k.n_rows() {
         for b in k.offsets[i]..k.offsets[i + 1] {
@@ -203,7 +204,8 @@ fn assembly_matches_a_pairwise_reference() {
 
 fn assembly_check(model: &Model) {
     let spec = dual_horizon_case("", "lattice").spec;
-    let (c, h) = (&model.cloud, &model.horizons);
+    let c = &model.cloud;
+    let h = &peritherm::neighbors::Horizons::build(c, &spec.kernel);
     let w = peritherm::operator::directed_weights(
         c,
         h,
@@ -434,8 +436,7 @@ fn neighbour_search_grid_equals_tree() {
     ));
     assert_eq!(a.offsets, b.offsets);
     assert_eq!(a.targets, b.targets);
-    assert_eq!(a.beta, b.beta);
-    assert_eq!(a.targets, model.horizons.targets);
+    assert_eq!(a.n_bonds(), model.bonds);
 }
 
 /// A rank's rows searched alone ([`Horizons::build_rows_with`], grid and k-d tree, 1 to 4
@@ -447,7 +448,7 @@ fn a_ranks_search_holds_its_rows_and_their_margin() {
     use peritherm::partition::Partition;
     let model = refined_dual_horizon(MIRROR_FACES);
     let kernel = dual_horizon_case("", "lattice").spec.kernel;
-    let whole = &model.horizons;
+    let whole = &Horizons::build(&model.cloud, &kernel);
     let row = |h: &Horizons, i: usize| h.targets[h.row(i)].to_vec();
     for grid in [true, false] {
         for ranks in 1..=4 {
@@ -640,6 +641,7 @@ fn abrupt_horizon_jumps_are_corrected_with_positive_conductances() {
 /// order.
 #[test]
 fn a_share_holds_the_whole_models_rows_bit_for_bit() {
+    use peritherm::neighbors::Horizons;
     use peritherm::partition::{own_halo, publishers, rule_sources};
     use peritherm::solve::exchange::RankPlan;
     let spec = refined_dual_horizon_spec(MIRROR_FACES);
@@ -670,7 +672,10 @@ fn a_share_holds_the_whole_models_rows_bit_for_bit() {
                 assert_eq!(bits(&s.vals[a]), bits(&k.vals[b]), "row {i}");
                 assert_eq!(s.diag[i].to_bits(), k.diag[i].to_bits(), "row {i}");
             }
-            bonds += share.bonds_into(rows.clone());
+            // a share counts its bonds as a search of its rows alone does
+            let census = Horizons::census(&share.cloud, &spec.kernel, &[rows.clone()]);
+            assert_eq!(share.bonds, census[0].bonds, "{ranks} ranks, rank {rank}");
+            bonds += share.bonds;
             // the halo a share plans alone is the one of the whole model (sends aside)
             let sources = rule_sources(share.cloud.len(), &share.boundary.linear_rules());
             let nb = share.cloud.n_body;
@@ -681,6 +686,7 @@ fn a_share_holds_the_whole_models_rows_bit_for_bit() {
                 (&plan.halo.recv, &plan.halo.publish)
             );
         }
-        assert_eq!(bonds, whole.horizons.n_bonds(), "{ranks} ranks");
+        let all = Horizons::build(&whole.cloud, &spec.kernel).n_bonds();
+        assert_eq!((bonds, whole.bonds), (all, all), "{ranks} ranks");
     }
 }

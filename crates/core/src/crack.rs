@@ -8,8 +8,9 @@
 //! fictitious node's bonds may cross only the sets it was mirrored across.
 
 use crate::cloud::{Cloud, Fictitious};
+use crate::kernel::Kernel;
 use crate::math::{Point, Vector};
-use crate::neighbors::Horizons;
+use crate::neighbors::{partial_volume, Horizons};
 use crate::spatial::PointIndex;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -59,7 +60,7 @@ pub fn growing_path(points: &[Point], mu: f64, growth: Growth) -> Vec<Cutter> {
 /// Bond cuts: the fraction μ of every directed bond now, and the later cuts of growing cracks.
 #[derive(Debug, Clone, Default)]
 pub struct Cuts {
-    /// μ per directed bond at t = 0 (1 where nothing cuts it).
+    /// μ per directed bond at t = 0 (1 where nothing cuts it; empty where nothing cuts any).
     pub mu: Vec<f64>,
     /// (directed bond, time it is cut, μ it keeps), for bonds a growing crack reaches later.
     pub later: Vec<(usize, f64, f64)>,
@@ -184,18 +185,15 @@ pub fn facet_cutters(corners: &[Point], mu: f64, boundary: Option<Option<u16>>) 
 }
 
 /// The conductance fraction μ of every directed bond of `horizons` (1 where nothing cuts it)
-/// and the later cuts of growing cracks. Each pair is tested with its ends in index order, so
-/// μ_ij = μ_ji bit for bit.
+/// and the later cuts of growing cracks; where nothing is cut, no factor at all (`mu` empty:
+/// every bond whole). Each pair is tested with its ends in index order, so μ_ij = μ_ji bit for bit.
 pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> Cuts {
-    // filled in parallel: at 10⁷ nodes this is gigabytes of fresh pages
-    let mut mu = Vec::with_capacity(horizons.n_bonds());
-    mu.par_extend(rayon::iter::repeat_n(1.0, horizons.n_bonds()));
     if cutters.is_empty() {
-        return Cuts {
-            mu,
-            later: Vec::new(),
-        };
+        return Cuts::default();
     }
+    // filled in parallel: at 10⁷ nodes this is gigabytes of fresh pages
+    let mut mu: Vec<f64> = Vec::with_capacity(horizons.n_bonds());
+    mu.par_extend(rayon::iter::repeat_n(1.0, horizons.n_bonds()));
     let centres: Vec<Point> = cutters.iter().map(Cutter::centre).collect();
     let radius = cutters
         .iter()
@@ -261,6 +259,10 @@ pub fn bond_factors(cloud: &Cloud, horizons: &Horizons, cutters: &[Cutter]) -> C
             later
         })
         .collect();
+    if later.is_empty() && mu.par_iter().all(|&m| m == 1.0) {
+        // nothing cut (a convex body without cracks): hold no factor
+        return Cuts::default();
+    }
     Cuts { mu, later }
 }
 
@@ -298,26 +300,81 @@ pub fn restore_moment(cloud: &Cloud, horizons: &Horizons, mu: &[f64], weights: &
         });
 }
 
-/// Damage of every body node (theory §5): φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over
-/// the directed bonds of i (0 intact, 1 with every bond cut).
-pub fn damage(cloud: &Cloud, horizons: &Horizons, mu: &[f64]) -> Vec<f64> {
-    (0..cloud.n_body)
-        .into_par_iter()
-        .with_min_len(1024)
-        .map(|i| {
-            let (mut kept, mut all) = (0.0, 0.0);
-            for b in horizons.row(i) {
-                let v = horizons.beta[b] * cloud.volume[horizons.targets[b] as usize];
-                kept += mu[b] * v;
-                all += v;
+/// What the damage of the body nodes needs of their directed bonds (theory §5), held by a
+/// model with cracks in place of its neighbour lists: each body row's β_ij V_j and the cracks'
+/// cuts.
+#[derive(Debug, Clone, Default)]
+pub struct DamageBonds {
+    /// Start of each body row's directed bonds, length n_body + 1.
+    offsets: Vec<usize>,
+    /// β_ij V_j of every directed bond of the body rows, m³ (m² in 2D, m in 1D).
+    volume: Vec<f64>,
+    /// The cracks' factors μ of every directed bond ([`bond_factors`] of the cracks alone).
+    pub cuts: Cuts,
+}
+
+impl DamageBonds {
+    /// The body rows of `horizons` with their cracks' `cuts`.
+    pub fn new(cloud: &Cloud, horizons: &Horizons, kernel: &Kernel, cuts: Cuts) -> Self {
+        let offsets = horizons.offsets[..=cloud.n_body].to_vec();
+        let volume = (0..cloud.n_body)
+            .into_par_iter()
+            .with_min_len(1024)
+            .flat_map_iter(|i| {
+                horizons.row(i).map(move |b| {
+                    let j = horizons.targets[b] as usize;
+                    partial_volume(cloud, kernel, i, j) * cloud.volume[j]
+                })
+            })
+            .collect();
+        DamageBonds {
+            offsets,
+            volume,
+            cuts,
+        }
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.offsets.capacity() * 8
+            + self.volume.capacity() * 8
+            + self.cuts.mu.capacity() * 8
+            + self.cuts.later.capacity() * 24
+    }
+
+    /// Damage of every body node at time `t` (theory §5), growing cracks included:
+    /// φ_i = 1 − Σ_j μ_ij β_ij V_j / Σ_j β_ij V_j over the directed bonds of i (0 intact, 1
+    /// with every bond cut).
+    pub fn at(&self, t: f64) -> Vec<f64> {
+        let c = &self.cuts;
+        let n = self.offsets.len() - 1;
+        if c.mu.is_empty() {
+            return vec![0.0; n];
+        }
+        let mut mu = c.mu.clone();
+        for &(b, tc, m) in &c.later {
+            if tc <= t {
+                mu[b] = mu[b].min(m);
             }
-            if all > 0.0 {
-                1.0 - kept / all
-            } else {
-                0.0
-            }
-        })
-        .collect()
+        }
+        (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                let (mut kept, mut all) = (0.0, 0.0);
+                for b in self.offsets[i]..self.offsets[i + 1] {
+                    let v = self.volume[b];
+                    kept += mu[b] * v;
+                    all += v;
+                }
+                if all > 0.0 {
+                    1.0 - kept / all
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
 }
 
 /// The 2D crack segments present at time `t` (growing cracks up to their tips), m.

@@ -86,8 +86,9 @@ pub struct Element {
     pub kind: ElementKind,
     /// Node indices (0-based, into [`Mesh::nodes`]), in the file's order.
     pub nodes: Vec<u32>,
-    /// Indices into [`Mesh::groups`] (groups of the element's own dimension).
-    pub groups: Vec<u16>,
+    /// Indices into [`Mesh::groups`] (groups of the element's own dimension), shared by the
+    /// elements of one gmsh entity (one allocation per entity, not per element).
+    pub groups: std::sync::Arc<[u16]>,
 }
 
 /// A mesh: node coordinates, elements of every dimension and the physical groups.

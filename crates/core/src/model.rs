@@ -4,7 +4,7 @@ use crate::bc::{Boundary, BoundaryInput, FaceBc};
 use crate::cloud::mesh::MeshGeometry;
 use crate::cloud::{BoxGeometry, Cloud, Sides};
 use crate::crack::{
-    bond_factors, damage, facet_cutters, growing_path, segments, Cuts, Cutter, Growth,
+    bond_factors, facet_cutters, growing_path, segments, Cuts, Cutter, DamageBonds, Growth,
 };
 use crate::error::{Error, Result};
 use crate::expr::Expr;
@@ -12,7 +12,7 @@ use crate::kernel::{Kernel, PartialVolume};
 use crate::material::{BondRule, Enthalpy, Material};
 use crate::math::Point;
 use crate::neighbors::Horizons;
-use crate::operator::{directed_weights, Conductance};
+use crate::operator::{Conductance, HalfConductance};
 use crate::partition::Partition;
 use crate::symmetry::Symmetry;
 use crate::weights::store::Store;
@@ -197,13 +197,31 @@ fn complete_horizons(
         .collect()
 }
 
+/// Directed bonds of the body rows `rows` of `horizons`, plus the bonds from fictitious nodes
+/// into them: summed over the ranges of a partition, the bonds of the whole model.
+fn bonds_into(cloud: &Cloud, h: &Horizons, rows: Range<usize>) -> usize {
+    let rows = &rows;
+    let body = h.offsets[rows.end] - h.offsets[rows.start];
+    let fictitious: usize = (cloud.n_body..h.len())
+        .map(|f| {
+            let t = &h.targets[h.row(f)];
+            t.iter().filter(|&&i| rows.contains(&(i as usize))).count()
+        })
+        .sum();
+    body + fictitious
+}
+
 /// An assembled model.
 #[derive(Debug, Clone)]
 pub struct Model {
     /// Nodes (body first, then fictitious).
     pub cloud: Cloud,
-    /// Directed neighbour lists.
-    pub horizons: Horizons,
+    /// Directed bonds of the body rows it holds and from fictitious nodes into them (the
+    /// neighbour lists themselves are dropped once K is assembled: K holds every pair).
+    pub bonds: usize,
+    /// The body nodes of its rows without a directed bond of their own (a horizon that
+    /// reaches no node; empty in a model a run accepts).
+    pub bondless: Vec<usize>,
     /// Symmetric pair conductance, W/K.
     pub conductance: Conductance,
     /// Conductivity per node (with phase change: the largest of its phases), W/(m·K).
@@ -228,8 +246,8 @@ pub struct Model {
     pub consistent: Vec<bool>,
     /// Later cuts of pairs by growing cracks, in time order.
     pub growth: Vec<PairCut>,
-    /// Cuts of the directed bonds by cracks alone (for damage).
-    pub crack_cuts: Cuts,
+    /// What the damage of cracks needs of the directed bonds (None without cracks).
+    pub damage: Option<DamageBonds>,
     /// The body rows whose bonds and K this model holds: all of them, or one rank's share
     /// ([`Model::build_share`]).
     pub rows: Range<usize>,
@@ -296,8 +314,9 @@ fn pair_cuts(
 /// The bonds of a model after the cracks and the consistency correction: the stage of
 /// [`Model::build`] between the neighbour search and the boundary.
 struct Bonds {
-    /// Directed bond weights ([`directed_weights`]) with the cut factors applied.
-    weights: Vec<f64>,
+    /// Directed bond weights ([`directed_weights`]) with the cut factors applied, held only
+    /// where a later stage reads them (nodal flux relations: [`Bonds::micro`]).
+    weights: Option<Vec<f64>>,
     /// The assembled (and possibly corrected) conductance.
     conductance: Conductance,
     /// The consistency correction, when one was asked for and applies.
@@ -306,8 +325,8 @@ struct Bonds {
     consistent: Vec<bool>,
     /// Conductance entries of the bonds cut later by growing cracks.
     growth: Vec<PairCut>,
-    /// The bond factors of the cracks alone (for damage).
-    crack_cuts: Cuts,
+    /// What the damage needs (a model with cracks; None without).
+    damage: Option<DamageBonds>,
 }
 
 /// Checks the materials of a spec and the conditions that do not combine with phase change;
@@ -369,15 +388,14 @@ impl Bonds {
         rows: Range<usize>,
         store: Option<&dyn Store>,
     ) -> Bonds {
-        let mut weights = directed_weights(
+        let half = HalfConductance::new(
             cloud,
             horizons,
             &spec.kernel,
             bond_conductivity,
             spec.bond_rule,
         );
-        let cutters = cutters(cloud, &spec.cracks);
-        let cuts = bond_factors(cloud, horizons, &cutters);
+        let cuts = bond_factors(cloud, horizons, &cutters(cloud, &spec.cracks));
         let mu = &cuts.mu;
         // damage counts cracks only: bonds the boundary cuts (holes, notches) never existed
         let crack_cuts = if spec.cracks.is_empty() {
@@ -385,13 +403,28 @@ impl Bonds {
         } else {
             bond_factors(cloud, horizons, &crack_cutters(cloud, &spec.cracks))
         };
-        if spec.crack_correction {
-            crate::crack::restore_moment(cloud, horizons, &crack_cuts.mu, &mut weights);
-        }
-        for (w, m) in weights.iter_mut().zip(mu) {
-            *w *= m;
-        }
-        let mut conductance = Conductance::assemble_rows(cloud, horizons, &weights, rows);
+        let restores = spec.crack_correction && !crack_cuts.mu.is_empty();
+        // the directed weights are stored only where they change or are read again
+        let weights = (restores || needs_micro(spec, cloud)).then(|| {
+            let mut weights = half.all();
+            if restores {
+                crate::crack::restore_moment(cloud, horizons, &crack_cuts.mu, &mut weights);
+            }
+            for (w, m) in weights.iter_mut().zip(mu) {
+                *w *= m;
+            }
+            weights
+        });
+        let mut conductance = match &weights {
+            Some(w) => Conductance::assemble_rows(cloud, horizons, w, rows),
+            None => {
+                let at = |i: usize, b: usize| {
+                    let w = half.at(i, b);
+                    mu.get(b).map_or(w, |m| w * m)
+                };
+                Conductance::assemble_rows_with(cloud, horizons, &at, rows)
+            }
+        };
         let (correction, consistent) = correction_of(
             spec,
             (cloud, horizons, layered, mu),
@@ -400,31 +433,37 @@ impl Bonds {
             (store, Weights::Solve),
         );
         let growth = pair_cuts(cloud, horizons, &conductance, &cuts.later);
+        let damage = (!spec.cracks.is_empty())
+            .then(|| DamageBonds::new(cloud, horizons, &spec.kernel, crack_cuts));
         Bonds {
             weights,
             conductance,
             correction,
             consistent,
             growth,
-            crack_cuts,
+            damage,
         }
     }
 
     /// The micro-conductances 2w/V_i of every directed bond (w its weight, V_i the volume
     /// of its node), when a nodal flux relation needs them (2D and 3D); `None` otherwise.
     fn micro(&self, spec: &ModelSpec, cloud: &Cloud, horizons: &Horizons) -> Option<Vec<f64>> {
-        let needs_micro = spec
+        let weights = self.weights.as_ref().filter(|_| needs_micro(spec, cloud))?;
+        let micro = (0..horizons.len())
+            .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
+            .map(|(i, b)| 2.0 * weights[b] / cloud.volume[i])
+            .collect();
+        Some(micro)
+    }
+}
+
+/// Whether a nodal flux relation of `spec` needs the bonds' micro-conductances (2D and 3D).
+fn needs_micro(spec: &ModelSpec, cloud: &Cloud) -> bool {
+    cloud.dim > 1
+        && spec
             .faces
             .iter()
             .any(|f| matches!(f, FaceBc::RelationFlux { .. }))
-            && cloud.dim > 1;
-        needs_micro.then(|| {
-            (0..horizons.len())
-                .flat_map(|i| horizons.row(i).map(move |b| (i, b)))
-                .map(|(i, b)| 2.0 * self.weights[b] / cloud.volume[i])
-                .collect()
-        })
-    }
 }
 
 /// Whether `spec` asks for consistent weights where they apply (not on a symmetric cloud).
@@ -554,7 +593,7 @@ impl Model {
         let (phase, layered, cloud) = prelude(spec)?;
         let horizons = Horizons::build(&cloud, &spec.kernel);
         let rows = 0..cloud.n_body;
-        Self::finish(spec, cloud, horizons, phase, &layered, rows, store)
+        Self::finish(spec, cloud, &horizons, phase, &layered, rows, store)
     }
 
     /// [`Model::build_with`], calling `check` on the model before its consistent weights are
@@ -576,10 +615,10 @@ impl Model {
         let (phase, layered, cloud) = prelude(&bare)?;
         let horizons = Horizons::build(&cloud, &bare.kernel);
         let rows = 0..cloud.n_body;
-        let mut model = Self::finish(&bare, cloud, horizons, phase, &layered, rows, None)?;
+        let mut model = Self::finish(&bare, cloud, &horizons, phase, &layered, rows, None)?;
         check(&model)?;
         if corrects(spec, &model.cloud) {
-            model.correct(spec, phase, &layered, (store, weights));
+            model.correct(spec, (phase, &horizons, &layered), (store, weights));
         }
         Ok(model)
     }
@@ -589,8 +628,7 @@ impl Model {
     fn correct(
         &mut self,
         spec: &ModelSpec,
-        phase: bool,
-        layered: &[bool],
+        (phase, horizons, layered): (bool, &Horizons, &[bool]),
         store: (Option<&dyn Store>, Weights),
     ) {
         let cloud = &self.cloud;
@@ -599,15 +637,15 @@ impl Model {
         } else {
             heat_of(spec, cloud).0
         };
-        let cuts = bond_factors(cloud, &self.horizons, &cutters(cloud, &spec.cracks));
+        let cuts = bond_factors(cloud, horizons, &cutters(cloud, &spec.cracks));
         let (correction, consistent) = correction_of(
             spec,
-            (cloud, &self.horizons, layered, &cuts.mu),
+            (cloud, horizons, layered, &cuts.mu),
             &bond_conductivity,
             &mut self.conductance,
             store,
         );
-        self.growth = pair_cuts(cloud, &self.horizons, &self.conductance, &cuts.later);
+        self.growth = pair_cuts(cloud, horizons, &self.conductance, &cuts.later);
         self.correction = correction;
         self.consistent = consistent;
     }
@@ -636,7 +674,7 @@ impl Model {
         let partition = Partition::by_estimate(&cloud, ranks);
         let rows = partition.range(rank.min(partition.ranks() - 1));
         let horizons = Horizons::build_rows(&cloud, &spec.kernel, rows.clone());
-        let model = Self::finish(spec, cloud, horizons, phase, &layered, rows, None)?;
+        let model = Self::finish(spec, cloud, &horizons, phase, &layered, rows, None)?;
         Ok((model, partition))
     }
 
@@ -645,26 +683,11 @@ impl Model {
         self.shared_lambda = Some(lambda);
     }
 
-    /// Bonds of the body rows `rows` (held by this model), plus the bonds from fictitious
-    /// nodes into them: summed over the ranges of a partition, the bonds of the whole model.
-    pub fn bonds_into(&self, rows: Range<usize>) -> usize {
-        let h = &self.horizons;
-        let rows = &rows;
-        let body = h.offsets[rows.end] - h.offsets[rows.start];
-        let fictitious: usize = (self.cloud.n_body..h.len())
-            .map(|f| {
-                let t = &h.targets[h.row(f)];
-                t.iter().filter(|&&i| rows.contains(&(i as usize))).count()
-            })
-            .sum();
-        body + fictitious
-    }
-
     /// The model of `cloud` and `horizons`, its K assembled on `rows`.
     fn finish(
         spec: &ModelSpec,
         cloud: Cloud,
-        horizons: Horizons,
+        horizons: &Horizons,
         phase: bool,
         layered: &[bool],
         rows: Range<usize>,
@@ -680,14 +703,14 @@ impl Model {
         let bonds = Bonds::build(
             spec,
             &cloud,
-            &horizons,
+            horizons,
             layered,
             &bond_conductivity,
             rows.clone(),
             store,
         );
-        let micro = bonds.micro(spec, &cloud, &horizons);
-        let micro = micro.as_deref().map(|m| (&horizons, m));
+        let micro = bonds.micro(spec, &cloud, horizons);
+        let micro = micro.as_deref().map(|m| (horizons, m));
         let boundary = boundary_of(spec, &cloud, phase, (&conductivity, &capacity), micro);
         let (enthalpy, conductivity, capacity) =
             heat_properties(spec, &cloud, phase, conductivity, capacity);
@@ -701,12 +724,18 @@ impl Model {
             correction,
             consistent,
             growth,
-            crack_cuts,
+            damage,
             ..
         } = bonds;
+        let bonds = bonds_into(&cloud, horizons, rows.clone());
+        let bondless = rows
+            .clone()
+            .filter(|&i| horizons.row(i).is_empty())
+            .collect();
         Ok(Model {
             cloud,
-            horizons,
+            bonds,
+            bondless,
             conductance,
             conductivity,
             capacity,
@@ -718,7 +747,7 @@ impl Model {
             correction,
             consistent,
             growth,
-            crack_cuts,
+            damage,
             rows,
             shared_lambda: None,
         })
@@ -726,17 +755,10 @@ impl Model {
 
     /// Damage φ of every body node at time `t` (theory §5), growing cracks included.
     pub fn damage_at(&self, t: f64) -> Vec<f64> {
-        let c = &self.crack_cuts;
-        if c.mu.is_empty() {
-            return vec![0.0; self.cloud.n_body];
+        match &self.damage {
+            Some(d) => d.at(t),
+            None => vec![0.0; self.cloud.n_body],
         }
-        let mut mu = c.mu.clone();
-        for &(b, tc, m) in &c.later {
-            if tc <= t {
-                mu[b] = mu[b].min(m);
-            }
-        }
-        damage(&self.cloud, &self.horizons, &mu)
     }
 
     /// Total thermal energy of the body, Σ V_i ρc_i θ_i, J (relative to 0 °C); with phase

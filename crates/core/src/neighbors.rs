@@ -16,10 +16,9 @@ use rayon::prelude::*;
 pub struct Horizons {
     /// Row offsets, length n + 1.
     pub offsets: Vec<usize>,
-    /// Neighbour index j of each directed bond, sorted within a row.
+    /// Neighbour index j of each directed bond, sorted within a row (its partial-volume
+    /// factor is [`partial_volume`], recomputed where needed rather than stored).
     pub targets: Vec<NodeId>,
-    /// Partial-volume factor β_ij ∈ (0, 1].
-    pub beta: Vec<f64>,
 }
 
 /// Rows per parallel task of the search.
@@ -195,9 +194,16 @@ fn bond(cloud: &Cloud, kernel: &Kernel, i: usize, j: usize) -> Option<f64> {
     if j == i || (i >= nb && j >= nb) {
         return None;
     }
-    let r = (cloud.pos[j] - cloud.pos[i]).norm();
-    let (beta, _) = kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]);
+    let beta = partial_volume(cloud, kernel, i, j);
     (beta > 0.0).then_some(beta)
+}
+
+/// Partial-volume factor β_ij ∈ [0, 1] of the directed bond i → j (the fraction of node j's
+/// cell inside node i's horizon, [`Kernel::coverage`]); every bond of [`Horizons`] has β > 0.
+#[inline]
+pub fn partial_volume(cloud: &Cloud, kernel: &Kernel, i: usize, j: usize) -> f64 {
+    let r = (cloud.pos[j] - cloud.pos[i]).norm();
+    kernel.coverage(r, cloud.horizon[i], cloud.spacing[j]).0
 }
 
 /// What the body rows of one range hold, counted by the search alone (nothing stored).
@@ -254,42 +260,70 @@ fn reaches(cloud: &Cloud, kernel: &Kernel) -> Vec<f64> {
         .collect()
 }
 
-/// Pass 1 of [`Horizons::build_with`]: the sorted bonds (`keep(i, j)` is `Some`) of each
-/// block of [`SEARCH_CHUNK`] rows, in parallel, with each row's length written into `lens`.
-fn search_blocks<F>(
-    finder: &Finder,
-    pts: &[[f64; 3]],
-    reach: &[f64],
+/// The sorted bonds of row `i` (`keep(i, j)` is `Some`) into `found`; none for a row that
+/// `wanted` leaves out.
+#[inline]
+fn row_bonds<F>(
+    (finder, pts, reach): (&Finder, &[[f64; 3]], &[f64]),
+    keep: &F,
+    wanted: Option<&[bool]>,
+    i: usize,
+    found: &mut Vec<NodeId>,
+) where
+    F: Fn(usize, usize) -> Option<f64> + Sync,
+{
+    found.clear();
+    if wanted.is_some_and(|w| !w[i]) {
+        return;
+    }
+    finder.within(pts, i, reach[i] * reach[i] * (1.0 + 1e-12), found);
+    found.retain(|&j| keep(i, j as usize).is_some());
+    found.sort_unstable();
+}
+
+/// Pass 1 of [`Horizons::build_with`]: the number of bonds of every row, in parallel blocks
+/// of [`SEARCH_CHUNK`] rows, into `lens`. Nothing is kept: pass 2 ([`fill_blocks`]) searches
+/// again straight into the final array, which costs a second search but never holds the
+/// bonds twice (nor leaves the allocator the freed pieces of a first copy).
+fn count_rows<F>(
+    search: (&Finder, &[[f64; 3]], &[f64]),
     keep: &F,
     wanted: Option<&[bool]>,
     lens: &mut [usize],
-) -> Vec<Vec<NodeId>>
-where
+) where
     F: Fn(usize, usize) -> Option<f64> + Sync,
 {
     lens.par_chunks_mut(SEARCH_CHUNK)
         .enumerate()
-        .map(|(c, lens)| {
-            let first = c * SEARCH_CHUNK;
-            let mut list = Vec::new();
+        .for_each(|(c, lens)| {
             let mut found = Vec::new();
             for (r, len) in lens.iter_mut().enumerate() {
-                let i = first + r;
-                if wanted.is_some_and(|w| !w[i]) {
-                    *len = 0;
-                    continue;
-                }
-                found.clear();
-                finder.within(pts, i, reach[i] * reach[i] * (1.0 + 1e-12), &mut found);
-                found.retain(|&j| keep(i, j as usize).is_some());
-                found.sort_unstable();
+                row_bonds(search, keep, wanted, c * SEARCH_CHUNK + r, &mut found);
                 *len = found.len();
-                list.extend_from_slice(&found);
             }
-            list.shrink_to_fit();
-            list
-        })
-        .collect()
+        });
+}
+
+/// Pass 2 of [`Horizons::build_with`]: each block's rows searched again into its part of the
+/// targets (`parts`, from [`block_parts`]).
+fn fill_blocks<F>(
+    search: (&Finder, &[[f64; 3]], &[f64]),
+    keep: &F,
+    wanted: Option<&[bool]>,
+    n: usize,
+    parts: Vec<&mut [NodeId]>,
+) where
+    F: Fn(usize, usize) -> Option<f64> + Sync,
+{
+    parts.into_par_iter().enumerate().for_each(|(c, t)| {
+        let mut found = Vec::new();
+        let mut at = 0;
+        for i in c * SEARCH_CHUNK..((c + 1) * SEARCH_CHUNK).min(n) {
+            row_bonds(search, keep, wanted, i, &mut found);
+            t[at..at + found.len()].copy_from_slice(&found);
+            at += found.len();
+        }
+    });
 }
 
 /// Marks the rows `rows` and every node j with a bond j → i into one of them (`keep(j, i)`),
@@ -330,28 +364,24 @@ where
     wanted
 }
 
-/// The targets and β of each of `n_blocks` blocks of [`SEARCH_CHUNK`] rows, as disjoint
+/// The targets of each of `n_blocks` blocks of [`SEARCH_CHUNK`] rows, as disjoint
 /// mutable slices of the final arrays (CSR row starts `offsets`), for pass 2.
 fn block_parts<'a>(
     offsets: &[usize],
     n_blocks: usize,
     targets: &'a mut [NodeId],
-    beta: &'a mut [f64],
-) -> Vec<(&'a mut [NodeId], &'a mut [f64])> {
+) -> Vec<&'a mut [NodeId]> {
     let total = targets.len();
     let starts: Vec<usize> = (0..n_blocks)
         .map(|c| offsets[c * SEARCH_CHUNK])
         .chain(std::iter::once(total))
         .collect();
     let mut t_rest = targets;
-    let mut b_rest = beta;
     let mut parts = Vec::with_capacity(n_blocks);
     for w in starts.windows(2) {
-        let len = w[1] - w[0];
-        let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(len);
-        let (b, br) = std::mem::take(&mut b_rest).split_at_mut(len);
-        parts.push((t, b));
-        (t_rest, b_rest) = (tr, br);
+        let (t, tr) = std::mem::take(&mut t_rest).split_at_mut(w[1] - w[0]);
+        parts.push(t);
+        t_rest = tr;
     }
     parts
 }
@@ -422,10 +452,10 @@ impl Horizons {
             Finder::Grid(g) => g.near(&pts, rows, reach.iter().cloned().fold(0.0, f64::max)),
             Finder::Tree(_) => reaching(&finder, &pts, &reach, &keep, rows),
         });
-        // pass 1: sorted neighbour lists of each block of rows, and the row lengths
+        // pass 1: the row lengths; pass 2: the same search into place
+        let search = (&finder, &pts[..], &reach[..]);
         let mut lens = vec![0usize; n];
-        let blocks = search_blocks(&finder, &pts, &reach, &keep, wanted.as_deref(), &mut lens);
-        drop(finder);
+        count_rows(search, &keep, wanted.as_deref(), &mut lens);
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0usize);
         for (i, len) in lens.iter().enumerate() {
@@ -436,26 +466,10 @@ impl Horizons {
         let mut h = Horizons {
             offsets,
             targets: vec![0; total],
-            beta: vec![0.0; total],
         };
-        // pass 2: copy each block into place with β
-        let parts = block_parts(&h.offsets, blocks.len(), &mut h.targets, &mut h.beta);
-        let offsets = &h.offsets;
-        blocks
-            .into_par_iter()
-            .zip(parts)
-            .enumerate()
-            .for_each(|(c, (list, (t, b)))| {
-                t.copy_from_slice(&list);
-                let first = c * SEARCH_CHUNK;
-                let last = (first + SEARCH_CHUNK).min(n);
-                let base = offsets[first];
-                for i in first..last {
-                    for k in offsets[i] - base..offsets[i + 1] - base {
-                        b[k] = keep(i, t[k] as usize).expect("kept in pass 1");
-                    }
-                }
-            });
+        let blocks = n.div_ceil(SEARCH_CHUNK);
+        let parts = block_parts(&h.offsets, blocks, &mut h.targets);
+        fill_blocks(search, &keep, wanted.as_deref(), n, parts);
         h
     }
 

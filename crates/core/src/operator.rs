@@ -35,34 +35,81 @@ pub fn directed_weights(
     conductivity: &[f64],
     rule: BondRule,
 ) -> Vec<f64> {
-    let mut w = vec![0.0; horizons.n_bonds()];
-    let units = unit_normalisations(cloud, kernel);
-    let sym = cloud.symmetry;
-    horizons
-        .rows_mut(&mut w)
-        .into_par_iter()
-        .with_min_len(256)
-        .for_each(|(i, slot)| {
-            let delta = cloud.horizon[i];
-            let unit = units[i];
-            for (s, b) in slot.iter_mut().zip(horizons.row(i)) {
-                let j = horizons.targets[b] as usize;
-                let r = (cloud.pos[j] - cloud.pos[i]).norm();
-                let k = rule.combine(conductivity[i], conductivity[j]);
-                // where Algorithm 1 evaluates the profile (lines 6 and 9)
-                let (_, at) = kernel.coverage(r, delta, cloud.spacing[j]);
-                let c = kernel.micro(unit * k, r, at, delta);
-                // planar measures times the ring/shell pair factor (theory §7)
-                let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
-                let shape = if sym.is_symmetric() {
-                    sym.pair_factor(ri, rj) / (sym.volume_factor(ri) * sym.volume_factor(rj))
-                } else {
-                    1.0
-                };
-                *s = 0.5 * cloud.volume[i] * cloud.volume[j] * shape * c * horizons.beta[b];
-            }
-        });
-    w
+    HalfConductance::new(cloud, horizons, kernel, conductivity, rule).all()
+}
+
+/// The half-conductance V_i V_j w_ij of any directed bond, W/K, computed where it is read:
+/// what [`directed_weights`] stores, for an assembly that need not hold them
+/// ([`Conductance::assemble_rows_with`]).
+pub struct HalfConductance<'a> {
+    cloud: &'a Cloud,
+    horizons: &'a Horizons,
+    kernel: &'a Kernel,
+    conductivity: &'a [f64],
+    rule: BondRule,
+    /// C_i for k = 1 per node.
+    units: Vec<f64>,
+}
+
+impl<'a> HalfConductance<'a> {
+    /// The half-conductances of the bonds of `horizons` for the per-node `conductivity`
+    /// (W/(m·K)) combined by `rule`.
+    pub fn new(
+        cloud: &'a Cloud,
+        horizons: &'a Horizons,
+        kernel: &'a Kernel,
+        conductivity: &'a [f64],
+        rule: BondRule,
+    ) -> Self {
+        let units = unit_normalisations(cloud, kernel);
+        HalfConductance {
+            cloud,
+            horizons,
+            kernel,
+            conductivity,
+            rule,
+            units,
+        }
+    }
+
+    /// Every bond's half-conductance, in the bonds' order, W/K.
+    pub fn all(&self) -> Vec<f64> {
+        let h = self.horizons;
+        let mut w = vec![0.0; h.n_bonds()];
+        h.rows_mut(&mut w)
+            .into_par_iter()
+            .with_min_len(256)
+            .for_each(|(i, slot)| {
+                for (s, b) in slot.iter_mut().zip(h.row(i)) {
+                    *s = self.at(i, b);
+                }
+            });
+        w
+    }
+
+    /// V_i V_j w_ij of bond `b` of row `i`, W/K.
+    #[inline]
+    pub fn at(&self, i: usize, b: usize) -> f64 {
+        let cloud = self.cloud;
+        let j = self.horizons.targets[b] as usize;
+        let delta = cloud.horizon[i];
+        let r = (cloud.pos[j] - cloud.pos[i]).norm();
+        let k = self
+            .rule
+            .combine(self.conductivity[i], self.conductivity[j]);
+        // where Algorithm 1 evaluates the profile (lines 6 and 9), and β_ij
+        let (beta, at) = self.kernel.coverage(r, delta, cloud.spacing[j]);
+        let c = self.kernel.micro(self.units[i] * k, r, at, delta);
+        // planar measures times the ring/shell pair factor (theory §7)
+        let sym = cloud.symmetry;
+        let (ri, rj) = (cloud.pos[i].x, cloud.pos[j].x);
+        let shape = if sym.is_symmetric() {
+            sym.pair_factor(ri, rj) / (sym.volume_factor(ri) * sym.volume_factor(rj))
+        } else {
+            1.0
+        };
+        0.5 * cloud.volume[i] * cloud.volume[j] * shape * c * beta
+    }
 }
 
 /// C_i for k = 1 at every node, computed once per distinct (Δ, δ) pair.
@@ -145,7 +192,7 @@ fn find(row: &[NodeId], i: NodeId, guess: usize) -> Option<usize> {
 fn lone_bonds(
     cloud: &Cloud,
     horizons: &Horizons,
-    weights: &[f64],
+    weights: &(impl Fn(usize, usize) -> f64 + Sync),
     rows: &Range<usize>,
 ) -> Vec<(NodeId, NodeId, f64)> {
     let n = horizons.len();
@@ -169,7 +216,7 @@ fn lone_bonds(
                 let guess = back.len().wrapping_sub(p + 1);
                 match find(back, j as NodeId, guess.min(back.len())) {
                     Some(_) => None,
-                    None => Some((i, j as NodeId, weights[start + p])),
+                    None => Some((i, j as NodeId, weights(j, start + p))),
                 }
             })
         })
@@ -222,6 +269,18 @@ impl Conductance {
         weights: &[f64],
         rows: Range<usize>,
     ) -> Self {
+        Self::assemble_rows_with(cloud, horizons, &|_, b| weights[b], rows)
+    }
+
+    /// [`Conductance::assemble_rows`] with the half-conductance of bond `b` of row `i` given
+    /// as `weights(i, b)` (a [`HalfConductance`], say, so that no per-bond array is held):
+    /// the same bits as the assembly of the stored values.
+    pub fn assemble_rows_with(
+        cloud: &Cloud,
+        horizons: &Horizons,
+        weights: &(impl Fn(usize, usize) -> f64 + Sync),
+        rows: Range<usize>,
+    ) -> Self {
         let nb = cloud.n_body;
         let targets = &horizons.targets;
         let row = |i: usize| &targets[horizons.row(i)];
@@ -251,7 +310,7 @@ impl Conductance {
                     }
                     let out = row(i);
                     let len = out.len();
-                    let ow = &weights[horizons.row(i)];
+                    let own = horizons.offsets[i];
                     let extra = &lone[lone_off[i]..lone_off[i + 1]];
                     let start = e;
                     let (mut a, mut b) = (0, 0);
@@ -263,8 +322,10 @@ impl Conductance {
                             let back = row(ju);
                             let guess = back.len().wrapping_sub(a + 1);
                             let w = match find(back, i as NodeId, guess.min(back.len())) {
-                                Some(q) => ow[a] + weights[horizons.offsets[ju] + q],
-                                None => ow[a],
+                                Some(q) => {
+                                    weights(i, own + a) + weights(ju, horizons.offsets[ju] + q)
+                                }
+                                None => weights(i, own + a),
                             };
                             cs[e] = ja;
                             vs[e] = w;

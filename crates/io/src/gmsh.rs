@@ -479,7 +479,7 @@ fn read_elements(
         let Some(physical) = entity_groups.get(&(dim, block.entity_tag)) else {
             continue;
         };
-        let member: Vec<u16> = physical
+        let member: std::sync::Arc<[u16]> = physical
             .iter()
             .filter_map(|p| groups.index.get(&(dim, *p)).copied())
             .collect();
@@ -513,6 +513,8 @@ fn read_elements(
             tags.push(tag);
         }
     }
+    elements.shrink_to_fit();
+    tags.shrink_to_fit();
     Ok((elements, tags))
 }
 

@@ -15,6 +15,7 @@ use peritherm_core::cloud::Cloud;
 use peritherm_core::math::{Point, Vector};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
+use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -51,19 +52,18 @@ pub struct Fields<'a> {
     pub reference: Option<&'a [f64]>,
 }
 
-/// CSV text of the body nodes: position, temperature, region, spacing, horizon, volume,
-/// damage and heat flux, and the classical reference when the case has one.
-pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
-    let mut s = String::with_capacity(cloud.n_body * 140);
-    s.push_str("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz");
-    s.push_str(if f.reference.is_some() {
-        ",reference\n"
+/// CSV text of the body nodes, written to `s`: position, temperature, region, spacing,
+/// horizon, volume, damage and heat flux, and the classical reference when the case has one.
+pub fn field_csv(s: &mut dyn Write, cloud: &Cloud, f: &Fields) -> std::io::Result<()> {
+    s.write_all("x,y,z,temperature,region,spacing,horizon,volume,damage,qx,qy,qz".as_bytes())?;
+    s.write_all(if f.reference.is_some() {
+        b",reference\n"
     } else {
-        "\n"
-    });
+        b"\n"
+    })?;
     for i in 0..cloud.n_body {
         let (p, q) = (cloud.pos[i], f.flux[i]);
-        let _ = write!(
+        write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{}",
             p.x,
@@ -78,45 +78,55 @@ pub fn field_csv(cloud: &Cloud, f: &Fields) -> String {
             q.x,
             q.y,
             q.z
-        );
+        )?;
         match f.reference {
-            Some(r) => {
-                let _ = writeln!(s, ",{}", r[i]);
-            }
-            None => s.push('\n'),
+            Some(r) => writeln!(s, ",{}", r[i])?,
+            None => s.write_all(b"\n")?,
         }
     }
-    s
+    Ok(())
 }
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
-/// Appends the standard base64 encoding of `bytes` (with padding).
-fn base64(bytes: &[u8], out: &mut String) {
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(B64[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
+/// Input bytes per block of [`base64`] (a multiple of 3, so the blocks join seamlessly).
+const B64_BLOCK: usize = 3 * 16_384;
+
+/// Writes the standard base64 encoding of `bytes` (with padding), a block at a time.
+fn base64(bytes: &[u8], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut text = Vec::with_capacity(B64_BLOCK / 3 * 4);
+    for block in bytes.chunks(B64_BLOCK) {
+        text.clear();
+        for c in block.chunks(3) {
+            let n = (c[0] as u32) << 16
+                | (*c.get(1).unwrap_or(&0) as u32) << 8
+                | *c.get(2).unwrap_or(&0) as u32;
+            for k in 0..4 {
+                text.push(match k <= c.len() {
+                    true => B64[(n >> (18 - 6 * k) & 63) as usize],
+                    false => b'=',
+                });
             }
         }
+        out.write_all(&text)?;
     }
+    Ok(())
 }
 
 /// A VTK XML `DataArray` in inline binary form: base64 of the byte count (UInt64), then
 /// base64 of the little-endian values, encoded separately as VTK's own writer does.
-fn vtk_array(out: &mut String, kind: &str, name: &str, comps: usize, bytes: &[u8]) {
-    let _ = write!(
+fn vtk_array(
+    out: &mut dyn Write,
+    (kind, name, comps): (&str, &str, usize),
+    bytes: &[u8],
+) -> std::io::Result<()> {
+    write!(
         out,
         "<DataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">"
-    );
-    base64(&(bytes.len() as u64).to_le_bytes(), out);
-    base64(bytes, out);
-    out.push_str("</DataArray>\n");
+    )?;
+    base64(&(bytes.len() as u64).to_le_bytes(), out)?;
+    base64(bytes, out)?;
+    out.write_all(b"</DataArray>\n")
 }
 
 fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
@@ -125,9 +135,9 @@ fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
 
 /// A VTK unstructured grid (`.vtu`) of the body nodes as vertices, with temperature, heat
 /// flux, damage, the classical reference (if any), horizon, spacing, volume and region, for
-/// ParaView.
-pub fn field_vtu(cloud: &Cloud, f: &Fields) -> String {
-    field_vtu_rows(cloud, f, 0..cloud.n_body)
+/// ParaView, written to `out`.
+pub fn field_vtu(out: &mut dyn Write, cloud: &Cloud, f: &Fields) -> std::io::Result<()> {
+    field_vtu_rows(out, cloud, f, 0..cloud.n_body)
 }
 
 /// The point arrays of a field's VTK files, in their order: (VTK type, name, components).
@@ -169,27 +179,30 @@ fn point_bytes(cloud: &Cloud, f: &Fields, name: &str, rows: Range<usize>) -> Vec
 
 /// [`field_vtu`] of the body nodes `rows` alone: one piece of a parallel file
 /// ([`field_pvtu`]).
-pub fn field_vtu_rows(cloud: &Cloud, f: &Fields, rows: Range<usize>) -> String {
+pub fn field_vtu_rows(
+    s: &mut dyn Write,
+    cloud: &Cloud,
+    f: &Fields,
+    rows: Range<usize>,
+) -> std::io::Result<()> {
     let n = rows.len();
-    let mut s = String::with_capacity(n * 140);
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n");
-    let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">");
-    s.push_str("<PointData Scalars=\"temperature\" Vectors=\"flux\">\n");
+    s.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n")?;
+    writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
+    s.write_all(b"<PointData Scalars=\"temperature\" Vectors=\"flux\">\n")?;
     for (kind, name, comps) in point_arrays(f.reference.is_some()) {
         let bytes = point_bytes(cloud, f, name, rows.clone());
-        vtk_array(&mut s, kind, name, comps, &bytes);
+        vtk_array(s, (kind, name, comps), &bytes)?;
     }
-    s.push_str("</PointData>\n<Points>\n");
+    s.write_all(b"</PointData>\n<Points>\n")?;
     let pos = cloud.pos[rows].iter().flat_map(|p| [p.x, p.y, p.z]);
-    vtk_array(&mut s, "Float64", "Points", 3, &f64_bytes(pos));
-    s.push_str("</Points>\n<Cells>\n");
+    vtk_array(s, ("Float64", "Points", 3), &f64_bytes(pos))?;
+    s.write_all(b"</Points>\n<Cells>\n")?;
     let ids: Vec<u8> = (0..n as i64).flat_map(i64::to_le_bytes).collect();
-    vtk_array(&mut s, "Int64", "connectivity", 1, &ids);
+    vtk_array(s, ("Int64", "connectivity", 1), &ids)?;
     let offsets: Vec<u8> = (1..=n as i64).flat_map(i64::to_le_bytes).collect();
-    vtk_array(&mut s, "Int64", "offsets", 1, &offsets);
-    vtk_array(&mut s, "UInt8", "types", 1, &vec![1u8; n]); // VTK_VERTEX
-    s.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    s
+    vtk_array(s, ("Int64", "offsets", 1), &offsets)?;
+    vtk_array(s, ("UInt8", "types", 1), &vec![1u8; n])?; // VTK_VERTEX
+    s.write_all(b"</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
 }
 
 /// Path of the k-th parallel VTK file (k from 1): `field_<k>.pvtu`, whose pieces are
@@ -692,9 +705,25 @@ mod tests {
             ("foo", "Zm9v"),
             ("foobar", "Zm9vYmFy"),
         ] {
-            let mut s = String::new();
-            base64(raw.as_bytes(), &mut s);
-            assert_eq!(s, enc);
+            let mut s = Vec::new();
+            base64(raw.as_bytes(), &mut s).unwrap();
+            assert_eq!(s, enc.as_bytes());
         }
+    }
+
+    /// Encoded a block at a time, a long array is the concatenation of its 3-byte groups'
+    /// encodings, across the blocks' seams and at its padded end.
+    #[test]
+    fn base64_blocks_join_seamlessly() {
+        let raw: Vec<u8> = (0..2 * super::B64_BLOCK + 5)
+            .map(|i| (i * 7 % 251) as u8)
+            .collect();
+        let mut whole = Vec::new();
+        base64(&raw, &mut whole).unwrap();
+        let mut groups = Vec::new();
+        for c in raw.chunks(3) {
+            base64(c, &mut groups).unwrap();
+        }
+        assert_eq!(whole, groups);
     }
 }

@@ -483,7 +483,7 @@ mod tests {
         Element {
             kind,
             nodes: nodes.to_vec(),
-            groups: vec![0],
+            groups: [0].into(),
         }
     }
 
@@ -513,7 +513,7 @@ mod tests {
         Mesh {
             nodes,
             elements,
-            groups: Vec::new(),
+            groups: [].into(),
         }
     }
 
@@ -537,7 +537,7 @@ mod tests {
         Mesh {
             nodes,
             elements,
-            groups: Vec::new(),
+            groups: [].into(),
         }
     }
 
