@@ -426,9 +426,9 @@ fn explicit_runs_agree_serial_and_parallel() {
 fn neighbour_search_grid_equals_tree() {
     let model = refined_dual_horizon(MIRROR_FACES);
     let kernel = dual_horizon_case("", "lattice").spec.kernel;
-    let a = peritherm::neighbors::Horizons::build_with(&model.cloud, &kernel, true);
-    let b = peritherm::neighbors::Horizons::build_with(&model.cloud, &kernel, false);
-    assert!(peritherm::neighbors::Horizons::grid_applies(
+    let a = peritherm::horizons::Horizons::build_with(&model.cloud, &kernel, true);
+    let b = peritherm::horizons::Horizons::build_with(&model.cloud, &kernel, false);
+    assert!(peritherm::horizons::Horizons::grid_applies(
         &model.cloud,
         &kernel
     ));
@@ -443,7 +443,7 @@ fn neighbour_search_grid_equals_tree() {
 /// (the margin the assembly reads: dual horizon, fictitious layers).
 #[test]
 fn a_ranks_search_holds_its_rows_and_their_margin() {
-    use peritherm::neighbors::Horizons;
+    use peritherm::horizons::Horizons;
     use peritherm::partition::Partition;
     let model = refined_dual_horizon(MIRROR_FACES);
     let kernel = dual_horizon_case("", "lattice").spec.kernel;

@@ -174,7 +174,7 @@ pub struct BoundaryInput<'a> {
     pub capacity: &'a [f64],
     /// Directed bonds and their micro-conductance per unit volume pair (for Bobaru & Duangpanya
     /// 2012 §3.2).
-    pub micro: Option<(&'a crate::neighbors::Horizons, &'a [f64])>,
+    pub micro: Option<(&'a crate::horizons::Horizons, &'a [f64])>,
     /// Volumetric source, W/m³.
     pub source: Option<Expr>,
 }

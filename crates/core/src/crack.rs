@@ -8,8 +8,8 @@
 //! fictitious node's bonds may cross only the sets it was mirrored across.
 
 use crate::cloud::{Cloud, Fictitious};
+use crate::horizons::Horizons;
 use crate::math::{Point, Vector};
-use crate::neighbors::Horizons;
 use crate::spatial::PointIndex;
 use rayon::prelude::*;
 use std::collections::HashMap;
