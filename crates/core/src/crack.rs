@@ -7,7 +7,8 @@
 //! body (across a hole or a re-entrant corner) are cut by the body's boundary facets, and a
 //! fictitious node's bonds may cross only the sets it was mirrored across.
 
-use crate::cloud::{Cloud, Fictitious};
+use crate::cloud::fictitious::Fictitious;
+use crate::cloud::Cloud;
 use crate::horizons::Horizons;
 use crate::math::{Point, Vector};
 use crate::spatial::PointIndex;
