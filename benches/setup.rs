@@ -4,8 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use peritherm::bench::plate;
+use peritherm::horizons::Horizons;
 use peritherm::model::{Geometry, Model};
-use peritherm::neighbors::Horizons;
 use peritherm::operator::{directed_weights, Conductance};
 use peritherm::stencil::Stencils;
 

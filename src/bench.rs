@@ -10,8 +10,8 @@
 
 use crate::case::Case;
 use crate::error::{Error, Result};
+use crate::horizons::Horizons;
 use crate::model::{Geometry, Model};
-use crate::neighbors::Horizons;
 use crate::operator::{directed_weights, Conductance};
 use crate::run::run_model;
 use crate::solve::explicit::{Explicit, ExplicitScheme};

@@ -13,13 +13,13 @@
 //! (`peritherm-fem`), the inputs and outputs (`peritherm-io`) and the post-processing
 //! (`peritherm-post`); `docs/architecture.md` describes the layers.
 //!
-//! Flow: [`case`] (TOML) → [`model::ModelSpec`] → [`cloud`] → [`neighbors`] →
+//! Flow: [`case`] (TOML) → [`model::ModelSpec`] → [`cloud`] → [`horizons`] →
 //! [`operator`] → [`bc`] → [`solve::explicit`] → [`output`]. Numerics never read files.
 #![warn(missing_docs)]
 
 pub use peritherm_analytic as analytic;
 pub use peritherm_core::{
-    bc, budget, cloud, crack, expr, kernel, limits, material, math, mesh, model, neighbors,
+    bc, budget, cloud, crack, expr, horizons, kernel, limits, material, math, mesh, model,
     operator, partition, progress, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{

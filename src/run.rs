@@ -216,7 +216,7 @@ fn bonds_of(case: &Case, model: &Model, rows: std::ops::Range<usize>) -> usize {
     if rows == model.rows {
         return model.bonds;
     }
-    let census = crate::neighbors::Horizons::census(&model.cloud, &case.spec.kernel, &[rows]);
+    let census = crate::horizons::Horizons::census(&model.cloud, &case.spec.kernel, &[rows]);
     census[0].bonds
 }
 

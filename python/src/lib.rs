@@ -340,8 +340,8 @@ struct PyModel {
 
 impl PyModel {
     /// The model's directed neighbour lists, searched anew (the model does not keep them).
-    fn horizons(&self) -> peritherm::neighbors::Horizons {
-        peritherm::neighbors::Horizons::build(&self.model.cloud, &self.case.spec.kernel)
+    fn horizons(&self) -> peritherm::horizons::Horizons {
+        peritherm::horizons::Horizons::build(&self.model.cloud, &self.case.spec.kernel)
     }
 
     /// Builds the model of `case` as a run does (budget, model, semantic checks, plan).

@@ -2,7 +2,8 @@
 //! conservation, symmetry of K, linear (and, with consistent weights, quadratic) fields
 //! kept steady, serial == parallel bit for bit, the explicit stability bound, the boundary
 //! rules, and the clouds built from gmsh meshes (volumes, neighbours, bonds cut at cracks
-//! and corners) with the reader's refusals.
+//! and corners) with the reader's refusals; and of the repository, that no module imports
+//! one that imports it back and that git tracks no generated file.
 //!
 //! Run this group with `cargo test --release --test properties`, one file of it with a
 //! filter, e.g. `cargo test --release --test properties weights::`.
@@ -18,4 +19,5 @@ mod gmsh;
 mod mesh;
 mod modules;
 mod operator;
+mod tracked;
 mod weights;

@@ -64,7 +64,7 @@ fn conductance_is_symmetric_and_bonds_are_directed() {
     let spec = dual_horizon_case("", "lattice").spec;
     let model = Model::build(&spec).unwrap();
     let k = &model.conductance;
-    let h = &peritherm::neighbors::Horizons::build(&model.cloud, &spec.kernel);
+    let h = &peritherm::horizons::Horizons::build(&model.cloud, &spec.kernel);
     let mut one_way = 0;
     for i in 0..k.n_rows() {
         for b in k.offsets[i]..k.offsets[i + 1] {
@@ -205,7 +205,7 @@ fn assembly_matches_a_pairwise_reference() {
 fn assembly_check(model: &Model) {
     let spec = dual_horizon_case("", "lattice").spec;
     let c = &model.cloud;
-    let h = &peritherm::neighbors::Horizons::build(c, &spec.kernel);
+    let h = &peritherm::horizons::Horizons::build(c, &spec.kernel);
     let w = peritherm::operator::directed_weights(
         c,
         h,
@@ -428,9 +428,9 @@ fn explicit_runs_agree_serial_and_parallel() {
 fn neighbour_search_grid_equals_tree() {
     let model = refined_dual_horizon(MIRROR_FACES);
     let kernel = dual_horizon_case("", "lattice").spec.kernel;
-    let a = peritherm::neighbors::Horizons::build_with(&model.cloud, &kernel, true);
-    let b = peritherm::neighbors::Horizons::build_with(&model.cloud, &kernel, false);
-    assert!(peritherm::neighbors::Horizons::grid_applies(
+    let a = peritherm::horizons::Horizons::build_with(&model.cloud, &kernel, true);
+    let b = peritherm::horizons::Horizons::build_with(&model.cloud, &kernel, false);
+    assert!(peritherm::horizons::Horizons::grid_applies(
         &model.cloud,
         &kernel
     ));
@@ -444,7 +444,7 @@ fn neighbour_search_grid_equals_tree() {
 /// (the margin the assembly reads: dual horizon, fictitious layers).
 #[test]
 fn a_ranks_search_holds_its_rows_and_their_margin() {
-    use peritherm::neighbors::Horizons;
+    use peritherm::horizons::Horizons;
     use peritherm::partition::Partition;
     let model = refined_dual_horizon(MIRROR_FACES);
     let kernel = dual_horizon_case("", "lattice").spec.kernel;
@@ -641,7 +641,7 @@ fn abrupt_horizon_jumps_are_corrected_with_positive_conductances() {
 /// order.
 #[test]
 fn a_share_holds_the_whole_models_rows_bit_for_bit() {
-    use peritherm::neighbors::Horizons;
+    use peritherm::horizons::Horizons;
     use peritherm::partition::{own_halo, publishers, rule_sources};
     use peritherm::solve::exchange::RankPlan;
     let spec = refined_dual_horizon_spec(MIRROR_FACES);

@@ -6,19 +6,14 @@
 //! loads add to the rates (convection of PCS2022, doi:10.1007/s42102-022-00092-3, volumetric
 //! sources).
 
-use crate::cloud::{Cloud, Fictitious, Reflection};
+// the layer kind, now in cloud::fictitious, under its old path
+pub use crate::cloud::fictitious::Layer;
+
+use crate::cloud::fictitious::{Fictitious, Reflection};
+use crate::cloud::Cloud;
 use crate::expr::Expr;
 use crate::math::{NodeId, Point};
 use crate::spatial::PointIndex;
-
-/// How a fictitious layer takes its temperature from the body (theory §3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Layer {
-    /// θ_f = θ_b(t).
-    Naive,
-    /// Reflection of the body field across the face (Dirichlet, insulated or flux rule).
-    Mirror,
-}
 
 /// The condition on one boundary set (a box face or a mesh's physical group).
 #[derive(Debug, Clone, PartialEq)]
@@ -174,7 +169,7 @@ pub struct BoundaryInput<'a> {
     pub capacity: &'a [f64],
     /// Directed bonds and their micro-conductance per unit volume pair (for Bobaru & Duangpanya
     /// 2012 §3.2).
-    pub micro: Option<(&'a crate::neighbors::Horizons, &'a [f64])>,
+    pub micro: Option<(&'a crate::horizons::Horizons, &'a [f64])>,
     /// Volumetric source, W/m³.
     pub source: Option<Expr>,
 }

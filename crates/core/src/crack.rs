@@ -7,10 +7,11 @@
 //! body (across a hole or a re-entrant corner) are cut by the body's boundary facets, and a
 //! fictitious node's bonds may cross only the sets it was mirrored across.
 
-use crate::cloud::{Cloud, Fictitious};
+use crate::cloud::fictitious::Fictitious;
+use crate::cloud::Cloud;
+use crate::horizons::{partial_volume, Horizons};
 use crate::kernel::Kernel;
 use crate::math::{Point, Vector};
-use crate::neighbors::{partial_volume, Horizons};
 use crate::spatial::PointIndex;
 use rayon::prelude::*;
 use std::collections::HashMap;

@@ -1,5 +1,5 @@
 //! peritherm-core: the numerics layer of peritherm — node clouds ([`cloud`]), horizons
-//! ([`neighbors`]), kernels ([`kernel`]), the dual-horizon operator ([`operator`],
+//! ([`horizons`]), kernels ([`kernel`]), the dual-horizon operator ([`operator`],
 //! [`weights`], [`stencil`]), boundary conditions ([`bc`]), cracks ([`crack`]), materials
 //! ([`material`]), the model ([`model::ModelSpec`]) and the time integrators ([`solve`]),
 //! following `docs/theory.md` (the analytic references are the crate `peritherm-analytic`).
@@ -17,6 +17,7 @@ pub mod crack;
 pub mod error;
 pub mod expr;
 pub mod gather;
+pub mod horizons;
 pub mod kernel;
 pub mod limits;
 pub mod machine;
@@ -24,7 +25,6 @@ pub mod material;
 pub mod math;
 pub mod mesh;
 pub mod model;
-pub mod neighbors;
 pub mod operator;
 pub mod partition;
 pub mod progress;

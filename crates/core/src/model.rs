@@ -8,10 +8,10 @@ use crate::crack::{
 };
 use crate::error::{Error, Result};
 use crate::expr::Expr;
+use crate::horizons::Horizons;
 use crate::kernel::{Kernel, PartialVolume};
 use crate::material::{BondRule, Enthalpy, Material};
 use crate::math::Point;
-use crate::neighbors::Horizons;
 use crate::operator::{Conductance, HalfConductance};
 use crate::partition::Partition;
 use crate::symmetry::Symmetry;

@@ -7,10 +7,10 @@
 //! eqs. 10 and 21).
 
 use crate::cloud::Cloud;
+use crate::horizons::Horizons;
 use crate::kernel::Kernel;
 use crate::material::BondRule;
 use crate::math::{NodeId, Vector};
-use crate::neighbors::Horizons;
 use rayon::prelude::*;
 use std::ops::Range;
 

@@ -9,9 +9,9 @@
 //! Nothing here talks to other processes; [`crate::solve::exchange`] does.
 
 use crate::cloud::Cloud;
+use crate::horizons::Horizons;
 use crate::kernel::Kernel;
 use crate::math::NodeId;
-use crate::neighbors::Horizons;
 use crate::operator::Conductance;
 use rayon::prelude::*;
 use std::collections::HashSet;

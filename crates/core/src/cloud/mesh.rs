@@ -3,8 +3,9 @@
 //! fictitious layers made by mirroring body nodes across the nearest boundary facet.
 
 use super::facets::{Facet, FacetSet};
+use super::fictitious::{Fictitious, Reflection};
 use super::order::morton_order;
-use super::{Cloud, Fictitious, HorizonRule, MeshSides, Reflection, Sides};
+use super::{Cloud, HorizonRule, MeshSides, Sides};
 use crate::error::{Error, Result};
 use crate::math::{NodeId, Point, Vector};
 use crate::mesh::{contains, measure_and_centroid, Element, ElementKind, Mesh};

@@ -2,17 +2,21 @@
 //!
 //! A cloud holds the body nodes first (`0..n_body`) and the fictitious boundary-layer
 //! nodes after them (the fictitious regions of Wang, Oterkus & Oterkus, the mirror/naive layers of
-//! PCS2022). Every node has its own spacing Δ and horizon δ, which is
+//! PCS2022; their types are in [`fictitious`]). Every node has its own spacing Δ and horizon δ, which is
 //! what dual horizon needs (Wang, Oterkus & Oterkus §3).
 
 pub mod facets;
+pub mod fictitious;
 pub mod mesh;
 pub mod order;
 
 use crate::error::{Error, Result};
-use crate::math::{NodeId, Point, Vector, GEOMETRIC_TOLERANCE};
+use crate::math::{Point, Vector, GEOMETRIC_TOLERANCE};
 use crate::symmetry::Symmetry;
 use facets::FacetSet;
+
+// the fictitious nodes' types under their old paths
+pub use fictitious::{Fictitious, Reflection};
 
 /// Faces of an axis-aligned box, in the order x_min, x_max, y_min, y_max, z_min, z_max.
 pub const FACE_NAMES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"];
@@ -27,34 +31,6 @@ pub fn inward(face: Face) -> f64 {
     } else {
         -1.0
     }
-}
-
-/// One reflection of a mirrored fictitious node: across which set, where, and how far.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Reflection {
-    /// Boundary set crossed.
-    pub set: usize,
-    /// Foot of the reflection on the set (where boundary values are evaluated), m.
-    pub foot: Point,
-    /// Distance between the point and its mirror image, m.
-    pub distance: f64,
-}
-
-/// Where a fictitious node takes its temperature from (theory §3).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Fictitious {
-    /// A lattice node of a box geometry, outside the faces in the bit mask (bit f = face f).
-    Lattice {
-        /// Faces the node lies outside of.
-        outside: u8,
-    },
-    /// The image of body node `of` through `chain` (outermost reflection first).
-    Mirror {
-        /// The body node mirrored.
-        of: NodeId,
-        /// Reflections from the fictitious node back to `of`.
-        chain: Vec<Reflection>,
-    },
 }
 
 /// Boundary sets of a mesh-based cloud.
