@@ -6,8 +6,8 @@ use crate::cloud::{BoxGeometry, HorizonRule};
 use crate::error::Result;
 use crate::kernel::PartialVolume;
 use crate::limits::{
-    BYTES_PER_BOND, BYTES_PER_NODE, FEM_BYTES_PER_ENTRY, IMPLICIT_BOND_FACTOR, MAX_NEIGHBOURS,
-    MEMORY_FRACTION, SHARED_BYTES_PER_NODE,
+    BYTES_PER_BOND, BYTES_PER_NODE, CORRECTION_BYTES, CUT_BYTES_PER_BOND, FEM_BYTES_PER_ENTRY,
+    IMPLICIT_BYTES_PER_BOND, MAX_NEIGHBOURS, MEMORY_FRACTION, SHARED_BYTES_PER_NODE,
 };
 use crate::machine::Memory;
 use crate::model::{Geometry, ModelSpec};
@@ -133,7 +133,7 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
                 }
                 let r = &mut out[cloud.region[i] as usize];
                 r.0 += 1.0;
-                r.2 += ball(dim, m + 1.0);
+                r.2 += ball(dim, m);
             }
             if let Some(r) = out.iter().position(|c| c.0 == 0.0) {
                 return Err(crate::Error::model(
@@ -163,12 +163,22 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
             biggest = (r, bytes);
         }
     }
-    let factor = if implicit { IMPLICIT_BOND_FACTOR } else { 1.0 };
+    let mut per_bond = BYTES_PER_BOND;
+    if implicit {
+        per_bond += IMPLICIT_BYTES_PER_BOND;
+    }
+    let relation = spec
+        .faces
+        .iter()
+        .any(|f| matches!(f, crate::bc::FaceBc::RelationFlux { .. }));
+    if !spec.cracks.is_empty() || relation {
+        per_bond += CUT_BYTES_PER_BOND;
+    }
     Ok(Estimate {
         nodes,
         fictitious,
         bonds,
-        bytes: (nodes + fictitious) * BYTES_PER_NODE + bonds * BYTES_PER_BOND * factor + correction,
+        bytes: (nodes + fictitious) * BYTES_PER_NODE + bonds * per_bond + correction,
         key: size_keys
             .get(biggest.0)
             .cloned()
@@ -176,16 +186,22 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
     })
 }
 
-/// Bytes of the consistent weights' direct solve on a mesh cloud (every node takes part): the
+/// Bytes of the consistent weights' solve on a mesh cloud (every node takes part): the
 /// direct factor of [`crate::weights::estimate`] (2D, at most
-/// [`crate::limits::MAX_DIRECT_ENTRIES`] entries at [`crate::limits::CORRECTION_BYTES_PER_ENTRY`]), else 0 (CG, whose vectors the per-node bytes cover).
+/// [`crate::limits::MAX_DIRECT_ENTRIES`] entries at
+/// [`crate::limits::CORRECTION_BYTES_PER_ENTRY`]) and the iterative solve's
+/// [`CORRECTION_BYTES`] per bond and node; 0 without a correction.
 fn correction_bytes(spec: &ModelSpec, dim: usize, per_region: &[(f64, f64, f64)]) -> f64 {
     if spec.symmetry.is_symmetric() {
         return 0.0;
     }
     let nodes: f64 = per_region.iter().map(|r| r.0 + r.1).sum();
     let pairs: f64 = per_region.iter().map(|r| r.2).sum();
-    crate::weights::estimate(dim, spec.consistency, nodes, pairs).bytes
+    let factor = crate::weights::estimate(dim, spec.consistency, nodes, pairs).bytes;
+    if spec.consistency == crate::weights::Order::None {
+        return factor;
+    }
+    factor + pairs * CORRECTION_BYTES.0 + nodes * CORRECTION_BYTES.1
 }
 
 /// Per box region: body nodes, fictitious nodes of the layers on its faces that carry one,
@@ -215,7 +231,7 @@ fn box_regions(g: &BoxGeometry, layered: &[bool], band: f64) -> Vec<(f64, f64, f
                 body *= n;
                 with *= n + ext * (lo as u8 + hi as u8) as f64;
             }
-            let m = reg.horizon.horizon(h) / h + band + 1.0;
+            let m = reg.horizon.horizon(h) / h + band;
             (body, with - body, with * ball(g.dim, m))
         })
         .collect()

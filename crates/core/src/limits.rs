@@ -31,22 +31,33 @@ pub const MAX_HISTORY_POINTS: usize = 100;
 pub const MAX_HISTORY_ROWS: f64 = 1e6;
 
 /// Bytes of set-up and run memory per node (positions, spacings, volumes, state vectors, the
-/// boundary's tables and the search structures): a conservative round figure, not a
-/// measurement (about fifty f64 per node).
-pub const BYTES_PER_NODE: f64 = 1024.0;
+/// boundary's tables, the search structures and a mesh's elements): measured peaks less the
+/// bonds' bytes left 160 B per node on the 10⁷-node lattice plate and 340 B on the
+/// 10⁶-triangle square (its mesh held), B.
+pub const BYTES_PER_NODE: f64 = 300.0;
 /// Bytes per node that every rank of a distributed run holds whatever its share: the cloud
 /// (positions, volumes, spacing, horizon, regions: about 70 B), the gathered temperature and
 /// flux, the halo plan, B.
 pub const SHARED_BYTES_PER_NODE: f64 = 200.0;
 
-/// Bytes per directed bond at the peak of the set-up (neighbour lists of the search pass,
-/// bond weights and cut fractions, and the conductance's CSR column and value): about 40 B
-/// counted from those arrays, not measured; 64 keeps a margin.
-pub const BYTES_PER_BOND: f64 = 64.0;
+/// Bytes per directed bond at the peak of the set-up: the search's column (4 B) while K's
+/// column and value (12 B) are filled, and 2 B for the allocator's slack, B.
+pub const BYTES_PER_BOND: f64 = 18.0;
 
-/// Extra factor on the bond memory of the implicit integrators (the system matrix, its
-/// elimination and the sparse factor's fill).
-pub const IMPLICIT_BOND_FACTOR: f64 = 4.0;
+/// Extra bytes per directed bond of a case with cracks or nodal flux relations: the stored
+/// directed weights and cut factors, and what the damage reads (β V_j and the cracks' μ), B.
+pub const CUT_BYTES_PER_BOND: f64 = 32.0;
+
+/// Extra bytes per directed bond of the implicit integrators (the system matrix, its
+/// elimination and the sparse factor's fill): the 256 B of the earlier estimate less its
+/// explicit part, not remeasured, B.
+pub const IMPLICIT_BYTES_PER_BOND: f64 = 192.0;
+
+/// Extra bytes per directed bond and per node of the consistent weights' iterative solve on a
+/// mesh cloud (K before the correction and at the trial step, the Newton and CG vectors, the
+/// block-Jacobi blocks and the coarse level's modes): the unit cube of 36 447 tetrahedral
+/// nodes and 7.1·10⁶ bonds peaked at 0.66 GB, B.
+pub const CORRECTION_BYTES: (f64, f64) = (64.0, 3072.0);
 
 /// Bytes per stored entry of the FEM reference's matrices (mass and stiffness in CSR, and the
 /// sparse Cholesky factor's fill, taken as ten times the entries).
