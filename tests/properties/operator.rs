@@ -673,7 +673,7 @@ fn a_share_holds_the_whole_models_rows_bit_for_bit() {
                 assert_eq!(s.diag[i].to_bits(), k.diag[i].to_bits(), "row {i}");
             }
             // a share counts its bonds as a search of its rows alone does
-            let census = Horizons::census(&share.cloud, &spec.kernel, &[rows.clone()]);
+            let census = Horizons::census(&share.cloud, &spec.kernel, std::slice::from_ref(&rows));
             assert_eq!(share.bonds, census[0].bonds, "{ranks} ranks, rank {rank}");
             bonds += share.bonds;
             // the halo a share plans alone is the one of the whole model (sends aside)

@@ -363,9 +363,9 @@ impl DamageBonds {
             .with_min_len(1024)
             .map(|i| {
                 let (mut kept, mut all) = (0.0, 0.0);
-                for b in self.offsets[i]..self.offsets[i + 1] {
-                    let v = self.volume[b];
-                    kept += mu[b] * v;
+                let row = self.offsets[i]..self.offsets[i + 1];
+                for (m, v) in mu[row.clone()].iter().zip(&self.volume[row]) {
+                    kept += m * v;
                     all += v;
                 }
                 if all > 0.0 {
