@@ -1,9 +1,10 @@
 //! Directed neighbour lists (CSR): j is listed under i when j lies in i's horizon.
 //!
 //! The relation is directed because horizons differ from node to node (Wang, Oterkus & Oterkus,
-//! eqs. 19–22: the α masks); each entry carries the partial-volume factor β_ij (theory §2.3) and
-//! nothing else (the distance at which Algorithm 1 evaluates the kernel profile is recomputed
-//! by [`crate::kernel::Kernel::coverage`] where it is needed). Built once, in parallel.
+//! eqs. 19–22: the α masks); each entry is the neighbour's index and nothing else: its
+//! partial-volume factor β_ij (theory §2.3) and the distance at which Algorithm 1 evaluates the
+//! kernel profile are recomputed by [`crate::kernel::Kernel::coverage`] where they are needed
+//! ([`partial_volume`]). Built once, in parallel, and dropped by a model once K is assembled.
 
 use crate::cloud::Cloud;
 use crate::kernel::Kernel;
