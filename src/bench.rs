@@ -10,6 +10,7 @@
 
 use crate::case::Case;
 use crate::error::{Error, Result};
+use crate::gather::{ColumnIndex, Precision, StepStorage};
 use crate::horizons::Horizons;
 use crate::model::{Geometry, Model};
 use crate::operator::{directed_weights, Conductance};
@@ -77,7 +78,8 @@ pub struct CaseRow {
 pub struct StepRow {
     /// Configuration name, e.g. "2D m = 3".
     pub name: String,
-    /// Kernel: "CSR" (12 B streamed per bond) or "stencils" ([`crate::stencil`]).
+    /// Kernel: "CSR" (12 B streamed per bond), "stencils" ([`crate::stencil`]), "packed"
+    /// ([`crate::packed`]), or either with K in f32.
     pub kernel: &'static str,
     /// Body nodes.
     pub nodes: usize,
@@ -91,12 +93,13 @@ pub struct StepRow {
     pub read_1: f64,
     /// Median read bandwidth on N threads measured between the steps, GB/s.
     pub read_n: f64,
-    /// Bytes held by Horizons + Conductance per stored pair conductance, B.
+    /// Bytes held by the model's bond data per stored pair conductance, B.
     pub bytes_per_bond: f64,
     /// Bytes one step reads and writes per stored pair conductance ([`streamed_bytes`]), B.
     pub streamed_per_bond: f64,
-    /// Bytes held by the stencils per stored pair conductance (0 for CSR), B.
-    pub stencil_bytes_per_bond: f64,
+    /// Bytes the kernel holds beside K (stencils, packed columns, f32 values) per stored pair
+    /// conductance (0 for CSR), B.
+    pub extra_bytes_per_bond: f64,
 }
 
 /// Set-up times of a plate, s.
@@ -339,36 +342,92 @@ pub fn bond_bytes(model: &Model) -> usize {
 /// 1/(V_i ρc_i) read, the driven flag read, then the copy of the new θ back (read and write).
 const ROW_BYTES: usize = 8 + 8 + 8 + 1 + 16;
 
+/// A kernel of the step table: how the explicit step reads K.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepKernel {
+    /// CSR rows: a u64 offset per row, a u32 column and an f64 K_ij per bond.
+    Csr,
+    /// Shared stencils (lattices).
+    Stencils,
+    /// Packed columns (about 1 B per bond) and f64 K_ij.
+    Packed,
+    /// CSR columns and K_ij rounded to f32.
+    CsrF32,
+    /// Packed columns and K_ij rounded to f32.
+    PackedF32,
+}
+
+/// Every kernel of the step table, in its order.
+pub const STEP_KERNELS: [StepKernel; 5] = [
+    StepKernel::Csr,
+    StepKernel::Stencils,
+    StepKernel::Packed,
+    StepKernel::CsrF32,
+    StepKernel::PackedF32,
+];
+
+impl StepKernel {
+    /// The name in the step table.
+    pub fn name(self) -> &'static str {
+        match self {
+            StepKernel::Csr => "CSR",
+            StepKernel::Stencils => "stencils",
+            StepKernel::Packed => "packed",
+            StepKernel::CsrF32 => "CSR, f32",
+            StepKernel::PackedF32 => "packed, f32",
+        }
+    }
+
+    /// The storage the explicit stepper is set to.
+    fn storage(self) -> StepStorage {
+        let (columns, precision) = match self {
+            StepKernel::Csr | StepKernel::Stencils => (ColumnIndex::U32, Precision::F64),
+            StepKernel::Packed => (ColumnIndex::Packed, Precision::F64),
+            StepKernel::CsrF32 => (ColumnIndex::U32, Precision::F32),
+            StepKernel::PackedF32 => (ColumnIndex::Packed, Precision::F32),
+        };
+        StepStorage { columns, precision }
+    }
+}
+
 /// Bytes one forward-Euler step moves between memory and the cores, each array counted once
 /// (the neighbours' θ_j are reused from cache in space-filling-curve order): the rows'
-/// bytes (41 per row), and K as the kernel reads it. CSR: a u64 offset per row, a u32 column and
-/// an f64 K_ij per bond; stencils (`stencil_bytes` held): a u16 stencil index per row and the
-/// stencils themselves, B.
-pub fn streamed_bytes(model: &Model, stencil_bytes: Option<usize>) -> f64 {
-    let rows = model.cloud.n_body;
-    let k = match stencil_bytes {
-        None => rows * 8 + model.conductance.nnz() * BYTES_PER_BOND as usize,
-        Some(held) => rows * 2 + held,
+/// bytes (41 per row), and K as `kernel` reads it, which holds `held` bytes beside K. CSR: a
+/// u64 offset per row, a u32 column and an f64 K_ij per bond; stencils: a u16 stencil index per
+/// row and the stencils themselves; packed: the packed columns and K_ij; f32: 4 B per K_ij, B.
+pub fn streamed_bytes(model: &Model, kernel: StepKernel, held: usize) -> f64 {
+    let (rows, nnz) = (model.cloud.n_body, model.conductance.nnz());
+    let k = match kernel {
+        StepKernel::Csr => rows * 8 + nnz * BYTES_PER_BOND as usize,
+        StepKernel::Stencils => rows * 2 + held,
+        StepKernel::CsrF32 => rows * 8 + nnz * 8,
+        // the f32 values are held beside K: the packed bytes are the rest
+        StepKernel::Packed => held + nnz * 8,
+        StepKernel::PackedF32 => held,
     };
     (rows * ROW_BYTES + k) as f64
 }
 
 /// Euler steps of `model` on `pool` in three blocks of `reps / 3`, each block after two read
 /// passes on the same pool and one discarded step (so that steps and reads see the same load
-/// from elsewhere, and no timed step pays for evicting the read's arrays), through the
-/// stencils of K or the plain CSR rows: median step, s, median read bandwidth, GB/s, and the
-/// stencils' bytes (None when they are not used).
+/// from elsewhere, and no timed step pays for evicting the read's arrays), reading K as
+/// `kernel` does: median step, s, median read bandwidth, GB/s, and the bytes held beside K
+/// (None for stencils on a cloud whose rows do not repeat).
 pub fn time_step(
     pool: &ThreadPool,
     model: &Model,
     reps: usize,
-    stencils: bool,
+    kernel: StepKernel,
     bandwidth: &Bandwidth,
 ) -> (f64, f64, Option<usize>) {
     let dt = 0.5 * Integrator::Euler.stable_dt(model);
     let mut theta = model.theta0.clone();
     let mut st = pool.install(|| Explicit::new(model, ExplicitScheme::Euler));
-    let used = pool.install(|| st.set_stencils(stencils));
+    let stencils = kernel == StepKernel::Stencils;
+    let used = pool.install(|| {
+        st.set_storage(kernel.storage());
+        st.set_stencils(stencils) == stencils
+    });
     let mut steps = Vec::with_capacity(reps);
     let mut passes = Vec::new();
     let per_block = reps.div_ceil(3).max(1);
@@ -386,7 +445,7 @@ pub fn time_step(
     (
         median(steps),
         bandwidth.read_gbs(median(passes)),
-        used.then(|| st.stencil_bytes()),
+        used.then(|| st.stencil_bytes() + st.storage_bytes()),
     )
 }
 
@@ -466,6 +525,9 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         ));
         steps.extend(bench.step_rows(&name, &model, &mut say));
     }
+    if opts.nodes.is_none() {
+        steps.extend(mesh_steps(opts, &bench, &mut say)?);
+    }
     let cases = match &opts.cases {
         Some(dir) => time_cases(dir, &mut say)?,
         None => Vec::new(),
@@ -482,6 +544,47 @@ pub fn run(opts: &BenchOptions, mut say: impl FnMut(&str)) -> Result<BenchReport
         peak_rss: peak_rss(),
         nodes: opts.nodes,
     })
+}
+
+/// The gmsh square the step table times beside the plates: [`MESH_CASE`] on level 4 (quick:
+/// level 3), without consistent weights.
+pub fn mesh_case(quick: bool) -> Result<Case> {
+    let level = if quick { 3 } else { 4 };
+    let set: Vec<crate::sweep::Vary> = [
+        format!("mesh.file=\"../../meshes/scale_square_L{level}.msh\""),
+        "kernel.consistency=\"none\"".to_string(),
+    ]
+    .iter()
+    .map(|v| v.parse().map_err(|e: String| Error::model("bench", e)))
+    .collect::<Result<_>>()?;
+    crate::sweep::load_with(Path::new(MESH_CASE), &set)
+}
+
+/// The unit square of gmsh default triangles (from the repository root).
+pub const MESH_CASE: &str = "cases/large/scale_square.toml";
+
+/// The step rows of [`mesh_case`]; none, with a note, outside the repository.
+fn mesh_steps(
+    opts: &BenchOptions,
+    bench: &Bench,
+    say: &mut impl FnMut(&str),
+) -> Result<Vec<StepRow>> {
+    if !Path::new(MESH_CASE).exists() {
+        say(&format!(
+            "{MESH_CASE} not found (run from the repository root): no mesh rows"
+        ));
+        return Ok(Vec::new());
+    }
+    let name = "2D gmsh m = 3";
+    say(&format!("{name}: reading the mesh and building"));
+    let case = mesh_case(opts.quick)?;
+    let model = bench.pn.install(|| Model::build(&case.spec))?;
+    say(&format!(
+        "{name}: {} nodes, {} bonds: steps",
+        model.cloud.n_body,
+        model.conductance.nnz()
+    ));
+    Ok(bench.step_rows(name, &model, say))
 }
 
 /// The plates the benchmark times: (name, dimension, cells per side, m = δ/Δ).
@@ -544,22 +647,23 @@ impl Bench {
         Ok(row)
     }
 
-    /// The explicit step of `model` timed on one and on all threads, with the CSR kernel
-    /// and with stencils (when rows repeat), each beside a read-only pass.
+    /// The explicit step of `model` timed on one and on all threads with each kernel of
+    /// [`STEP_KERNELS`] (stencils when rows repeat), each beside a read-only pass.
     fn step_rows(&self, name: &str, model: &Model, say: &mut impl FnMut(&str)) -> Vec<StepRow> {
         let nnz = model.conductance.nnz() as f64;
         let bandwidth = Bandwidth::new(self.triad_len);
         let mut rows = Vec::new();
-        for (kernel, on) in [("CSR", false), ("stencils", true)] {
-            let (step_1, read_1, used) = time_step(&self.p1, model, self.step_reps, on, &bandwidth);
-            let Some(held) = (if on { used } else { Some(0) }) else {
+        let reps = self.step_reps;
+        for kernel in STEP_KERNELS {
+            let (step_1, read_1, used) = time_step(&self.p1, model, reps, kernel, &bandwidth);
+            let Some(held) = used else {
                 say(&format!("{name}: no stencils (rows do not repeat)"));
                 continue;
             };
-            let (step_n, read_n, _) = time_step(&self.pn, model, self.step_reps, on, &bandwidth);
+            let (step_n, read_n, _) = time_step(&self.pn, model, reps, kernel, &bandwidth);
             rows.push(StepRow {
                 name: name.to_string(),
-                kernel,
+                kernel: kernel.name(),
                 nodes: model.cloud.n_body,
                 bonds: model.conductance.nnz(),
                 step_1,
@@ -567,8 +671,8 @@ impl Bench {
                 read_1,
                 read_n,
                 bytes_per_bond: bond_bytes(model) as f64 / nnz,
-                streamed_per_bond: streamed_bytes(model, on.then_some(held)) / nnz,
-                stencil_bytes_per_bond: held as f64 / nnz,
+                streamed_per_bond: streamed_bytes(model, kernel, held) / nnz,
+                extra_bytes_per_bond: held as f64 / nnz,
             });
         }
         rows
@@ -661,7 +765,7 @@ impl BenchReport {
     fn step_table(&self) -> String {
         let n = self.threads;
         let mut s = format!(
-            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | read alongside, 1 / {n} threads | B held per bond (+ stencils) | B streamed per bond | of the read limit, 1 / {n} threads |\n"
+            "| explicit Euler step | kernel | nodes | bonds | step, 1 thread | step, {n} threads | speed-up | bond updates/s, 1 / {n} threads | read alongside, 1 / {n} threads | B held per bond (+ beside K) | B streamed per bond | of the read limit, 1 / {n} threads |\n"
         );
         s += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for r in &self.steps {
@@ -682,7 +786,7 @@ impl BenchReport {
                 r.read_1,
                 r.read_n,
                 r.bytes_per_bond,
-                r.stencil_bytes_per_bond,
+                r.extra_bytes_per_bond,
                 r.streamed_per_bond,
                 of_read(r1, r.read_1),
                 of_read(rn, r.read_n),

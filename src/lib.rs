@@ -19,8 +19,8 @@
 
 pub use peritherm_analytic as analytic;
 pub use peritherm_core::{
-    bc, budget, cloud, crack, expr, horizons, kernel, limits, material, math, mesh, model,
-    operator, partition, progress, solve, spatial, stencil, symmetry, weights,
+    bc, budget, cloud, crack, expr, gather, horizons, kernel, limits, material, math, mesh, model,
+    operator, packed, partition, progress, solve, spatial, stencil, symmetry, weights,
 };
 pub use peritherm_io::{
     atomic, case, gmsh, history, output, provenance, reference, series, staging, weights_cache,

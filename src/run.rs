@@ -5,6 +5,7 @@ use crate::case::{Case, ReferenceSource, ReferenceSpec};
 use crate::crack::tips_at;
 use crate::error::{CoreError, Error, IoError, Result};
 use crate::fem::run_fem;
+use crate::gather::StepStorage;
 use crate::history::{output_index, Recorder};
 use crate::model::crack_cutters;
 use crate::model::Model;
@@ -448,6 +449,7 @@ fn summary(
         reference_seconds: writer.reference_seconds + timing.fem_seconds,
         threads: rayon::current_num_threads(),
         consistency: model.correction,
+        step_storage: (model.step != StepStorage::default()).then(|| model.step.name()),
         reference: writer.comparisons,
         implicit: implicit.map(|st| st.stats),
         history: None,

@@ -705,6 +705,7 @@ fn write_recorded(
             settings: case.settings.clone(),
             origin: Some(origin),
             ranks: None,
+            step_storage: None,
         };
         summary.write(dir)?;
         Ok(summary)

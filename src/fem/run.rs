@@ -145,6 +145,7 @@ fn solve(
         settings: case.settings.clone(),
         origin: Some(origin),
         ranks: None,
+        step_storage: None,
     };
     summary.write(out)?;
     Ok(summary)

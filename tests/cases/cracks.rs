@@ -3,6 +3,7 @@
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
 use peritherm::case::Case;
+use peritherm::gather::{ColumnIndex, Precision, StepStorage};
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use std::path::PathBuf;
@@ -356,19 +357,35 @@ fn growing_crack_cuts_bonds_when_its_tip_passes() {
         .time;
     assert!((tc - 3.3).abs() < 1e-9);
     let dt = choose_dt(&model, Integrator::Euler, None).unwrap();
-    let mut theta = model.theta0.clone();
-    let e0 = model.energy(&theta);
-    let mut st = Explicit::new(&model, ExplicitScheme::Euler);
-    let mut t = 0.0;
-    while t < 3.4 {
-        st.step(&mut theta, t, dt);
-        t += dt;
-        let now = st.conductance().get(i, j);
-        assert_eq!(now, if t - dt >= tc { 0.0 } else { intact }, "t = {t}");
-        assert_eq!(now, st.conductance().get(j, i));
+    // K's own rows, the packed columns (the same bits), and the packed columns with K in f32
+    // (each cut entry rounded again: energy still conserved to round-off)
+    let mut fields = Vec::new();
+    for (columns, precision) in [
+        (ColumnIndex::U32, Precision::F64),
+        (ColumnIndex::Packed, Precision::F64),
+        (ColumnIndex::Packed, Precision::F32),
+    ] {
+        let mut theta = model.theta0.clone();
+        let e0 = model.energy(&theta);
+        let mut st = Explicit::new(&model, ExplicitScheme::Euler);
+        st.set_storage(StepStorage { columns, precision });
+        let mut t = 0.0;
+        while t < 3.4 {
+            st.step(&mut theta, t, dt);
+            t += dt;
+            let now = st.conductance().get(i, j);
+            assert_eq!(now, if t - dt >= tc { 0.0 } else { intact }, "t = {t}");
+            assert_eq!(now, st.conductance().get(j, i));
+        }
+        let drift = (model.energy(&theta) - e0).abs() / e0.abs();
+        assert!(
+            drift < 1e-12,
+            "{columns:?} {precision:?}: energy drift {drift:e}"
+        );
+        fields.push(theta);
     }
-    let drift = (model.energy(&theta) - e0).abs() / e0.abs();
-    assert!(drift < 1e-12, "energy drift {drift:e}");
+    assert_eq!(fields[0], fields[1], "packed columns change the bits");
+    assert_ne!(fields[0], fields[2], "f32 K must be read");
     assert!(model.damage_at(3.4)[i] > model.damage_at(0.0)[i]);
 }
 

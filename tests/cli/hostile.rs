@@ -73,6 +73,16 @@ fn refusals() -> Vec<(&'static str, String, &'static str)> {
             "reference.solution",
         ),
         (
+            "f32 with an implicit integrator",
+            PLATE.replace("[time]", "[kernel]\nprecision = \"f32\"\n[time]\nintegrator = \"crank_nicolson\"\ndt = 0.1"),
+            "kernel.precision",
+        ),
+        (
+            "an unknown column index",
+            PLATE.replace("[time]", "[kernel]\ncolumns = \"u8\"\n[time]"),
+            "kernel.columns",
+        ),
+        (
             "phase change with rk4",
             PLATE.replace("[boundary.x_min]", "[material.steel.phase_change]\ntemperature = 500.0\nlatent_heat = 3e5\nfrozen_conductivity = 40.0\nfrozen_specific_heat = 400.0\n[boundary.x_min]")
                 .replace("[time]", "[time]\nintegrator = \"rk4\""),

@@ -4,6 +4,7 @@
 
 use crate::common::case::CaseToml;
 use peritherm::case::Case;
+use peritherm::gather::{ColumnIndex, Precision, StepStorage};
 use peritherm::model::Model;
 use peritherm::solve::explicit::{choose_dt, Explicit, ExplicitScheme, Integrator};
 use peritherm::weights::Order;
@@ -27,11 +28,22 @@ fn dual_horizon_case(faces: &str, calibration: &str) -> Case {
 }
 
 /// Energy Σ V ρc θ stays constant over 1000 Euler steps on an insulated, non-uniform,
-/// dual-horizon cloud. Tolerance 1e-12 relative: the bond sum cancels pairwise (K_ij = K_ji
-/// bit for bit), leaving only summation round-off.
+/// dual-horizon cloud, with K in f64 and with K rounded to f32 (`kernel.precision = "f32"`).
+/// Tolerance 1e-12 relative: the bond sum cancels pairwise (K_ij = K_ji bit for bit, and so
+/// are their f32 roundings), leaving only summation round-off.
 #[test]
 fn energy_is_conserved_with_dual_horizon() {
-    for integ in [Integrator::Euler, Integrator::Rk4] {
+    let storages = [
+        StepStorage::default(),
+        StepStorage {
+            columns: ColumnIndex::Packed,
+            precision: Precision::F32,
+        },
+    ];
+    for (integ, storage) in [Integrator::Euler, Integrator::Rk4]
+        .into_iter()
+        .flat_map(|i| storages.map(|s| (i, s)))
+    {
         let case = dual_horizon_case("", "continuum");
         let model = Model::build(&case.spec).unwrap();
         // a twentieth of the stable step, so that the field still varies after 1000 steps
@@ -39,6 +51,7 @@ fn energy_is_conserved_with_dual_horizon() {
         let mut theta = model.theta0.clone();
         let e0 = model.energy(&theta);
         let mut st = Explicit::new(&model, integ.try_into().unwrap());
+        st.set_storage(storage);
         for s in 0..1000 {
             st.step(&mut theta, s as f64 * dt, dt);
         }
@@ -51,7 +64,8 @@ fn energy_is_conserved_with_dual_horizon() {
         );
         assert!(
             ((e1 - e0) / e0).abs() <= 1e-12,
-            "{integ:?}: drift {}",
+            "{integ:?} {}: drift {}",
+            storage.name(),
             (e1 - e0) / e0
         );
     }
@@ -348,8 +362,8 @@ fn serial_reference(model: &Model, integ: Integrator, dt: f64, steps: usize) -> 
     theta
 }
 
-/// Explicit runs on 1 and 2 threads, through the plain CSR rows or the stencils of K, give
-/// the same temperatures bit for bit, and agree with a plain serial implementation of the same
+/// Explicit runs on 1 and 2 threads, through the plain CSR rows, the stencils of K or the
+/// packed columns ([`peritherm::packed`]), give the same temperatures bit for bit, and agree with a plain serial implementation of the same
 /// scheme to 1e-12 relative (the kernels sum a row in another order than the serial product:
 /// round-off only), for Euler with and without loads and for RK4, with driven, fictitious and
 /// convective nodes.
@@ -375,7 +389,11 @@ fn explicit_runs_agree_serial_and_parallel() {
         assert!(model.cloud.n_fictitious() > 0);
         let dt = choose_dt(&model, integ, None).unwrap();
         let steps = 60;
-        let run = |threads: usize, stencils: bool| -> Vec<f64> {
+        let packed = StepStorage {
+            columns: ColumnIndex::Packed,
+            precision: Precision::F64,
+        };
+        let run_with = |threads: usize, stencils: bool, storage: StepStorage| -> Vec<f64> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -383,6 +401,7 @@ fn explicit_runs_agree_serial_and_parallel() {
             pool.install(|| {
                 let mut theta = model.theta0.clone();
                 let mut st = Explicit::new(&model, integ.try_into().unwrap());
+                st.set_storage(storage);
                 let used = st.set_stencils(stencils);
                 assert!(!used || stencils);
                 for s in 0..steps {
@@ -391,8 +410,15 @@ fn explicit_runs_agree_serial_and_parallel() {
                 theta
             })
         };
+        let run = |threads, stencils| run_with(threads, stencils, StepStorage::default());
         let one = run(1, false);
         assert_eq!(one, run(2, false), "{integ:?}: 1 and 2 threads differ");
+        assert_eq!(one, run_with(1, false, packed), "{integ:?}: packed differs");
+        assert_eq!(
+            one,
+            run_with(2, false, packed),
+            "{integ:?}: packed, 2 threads"
+        );
         if integ == Integrator::Euler {
             let mut st = Explicit::new(&model, integ.try_into().unwrap());
             stencils_seen |= st.set_stencils(true);

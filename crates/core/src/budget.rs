@@ -6,8 +6,9 @@ use crate::cloud::{BoxGeometry, HorizonRule};
 use crate::error::Result;
 use crate::kernel::PartialVolume;
 use crate::limits::{
-    BYTES_PER_BOND, BYTES_PER_NODE, CORRECTION_BYTES, CUT_BYTES_PER_BOND, FEM_BYTES_PER_ENTRY,
-    IMPLICIT_BYTES_PER_BOND, MAX_NEIGHBOURS, MEMORY_FRACTION, SHARED_BYTES_PER_NODE,
+    BYTES_PER_BOND, BYTES_PER_NODE, CORRECTION_BYTES, CUT_BYTES_PER_BOND, F32_BYTES_PER_BOND,
+    FEM_BYTES_PER_ENTRY, IMPLICIT_BYTES_PER_BOND, MAX_NEIGHBOURS, MEMORY_FRACTION,
+    PACKED_BYTES_PER_BOND, SHARED_BYTES_PER_NODE,
 };
 use crate::machine::Memory;
 use crate::model::{Geometry, ModelSpec};
@@ -174,6 +175,7 @@ pub fn estimate(spec: &ModelSpec, size_keys: &[String], implicit: bool) -> Resul
     if !spec.cracks.is_empty() || relation {
         per_bond += CUT_BYTES_PER_BOND;
     }
+    per_bond += step_bytes_per_bond(spec.step);
     Ok(Estimate {
         nodes,
         fictitious,
@@ -312,6 +314,20 @@ pub fn fem_box(size: &[f64], h: f64) -> (f64, f64) {
         nodes,
         nodes * BYTES_PER_NODE + entries * FEM_BYTES_PER_ENTRY,
     )
+}
+
+/// What the explicit step holds beside K per directed bond for `storage`, B.
+fn step_bytes_per_bond(storage: crate::gather::StepStorage) -> f64 {
+    use crate::gather::{ColumnIndex, Precision};
+    let packed = match storage.columns {
+        ColumnIndex::U32 => 0.0,
+        ColumnIndex::Packed => PACKED_BYTES_PER_BOND,
+    };
+    let rounded = match storage.precision {
+        Precision::F64 => 0.0,
+        Precision::F32 => F32_BYTES_PER_BOND,
+    };
+    packed + rounded
 }
 
 #[cfg(test)]

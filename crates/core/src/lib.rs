@@ -26,6 +26,7 @@ pub mod math;
 pub mod mesh;
 pub mod model;
 pub mod operator;
+pub mod packed;
 pub mod partition;
 pub mod progress;
 pub mod solve;

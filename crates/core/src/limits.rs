@@ -40,6 +40,14 @@ pub const BYTES_PER_NODE: f64 = 300.0;
 /// flux, the halo plan, B.
 pub const SHARED_BYTES_PER_NODE: f64 = 200.0;
 
+/// Bytes per directed bond that the explicit step holds beside K for `kernel.columns =
+/// "packed"` (about 1.7 B on gmsh triangles, [`crate::packed`]), B.
+pub const PACKED_BYTES_PER_BOND: f64 = 2.0;
+
+/// Bytes per directed bond that the explicit step holds beside K for `kernel.precision =
+/// "f32"` (the rounded K_ij), B.
+pub const F32_BYTES_PER_BOND: f64 = 4.0;
+
 /// Bytes per directed bond at the peak of the set-up: the search's column (4 B) while K's
 /// column and value (12 B) are filled, and 2 B for the allocator's slack, B.
 pub const BYTES_PER_BOND: f64 = 18.0;

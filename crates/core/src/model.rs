@@ -8,6 +8,7 @@ use crate::crack::{
 };
 use crate::error::{Error, Result};
 use crate::expr::Expr;
+use crate::gather::StepStorage;
 use crate::horizons::Horizons;
 use crate::kernel::{Kernel, PartialVolume};
 use crate::material::{BondRule, Enthalpy, Material};
@@ -124,6 +125,8 @@ pub struct ModelSpec {
     pub crack_correction: bool,
     /// Planar, axisymmetric or spherical body (PCS2022; theory §7).
     pub symmetry: Symmetry,
+    /// How the explicit step stores K's columns and values ([`crate::gather`]).
+    pub step: StepStorage,
 }
 
 /// Cutting facets of the cracks (theory §5).
@@ -254,6 +257,8 @@ pub struct Model {
     /// The bound of [`Model::lambda_max`] over every rank's rows, once a share has been told
     /// it ([`Model::set_lambda_max`]), 1/s.
     pub shared_lambda: Option<f64>,
+    /// How the explicit step stores K's columns and values (the spec's).
+    pub step: StepStorage,
 }
 
 /// A pair that a growing crack cuts at `time`: its K entries keep the fraction `mu`.
@@ -750,6 +755,7 @@ impl Model {
             damage,
             rows,
             shared_lambda: None,
+            step: spec.step,
         })
     }
 

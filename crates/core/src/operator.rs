@@ -132,20 +132,20 @@ pub const ROW_CHUNK: usize = 2048;
 /// added as (s0 + s1) + (s2 + s3) after the remainder joined s0. The order is fixed by the row
 /// alone, so every thread count gives the same bits (theory §2, gather form).
 #[inline(always)]
-pub fn row_sum(cols: &[NodeId], vals: &[f64], theta: &[f64], ti: f64) -> f64 {
+pub fn row_sum<V: Copy + Into<f64>>(cols: &[NodeId], vals: &[V], theta: &[f64], ti: f64) -> f64 {
     let n = cols.len().min(vals.len());
     let (cols, vals) = (&cols[..n], &vals[..n]);
     let mut a = [0.0f64; 4];
     let mut cc = cols.chunks_exact(4);
     let mut vc = vals.chunks_exact(4);
     for (c, v) in (&mut cc).zip(&mut vc) {
-        a[0] += v[0] * (theta[c[0] as usize] - ti);
-        a[1] += v[1] * (theta[c[1] as usize] - ti);
-        a[2] += v[2] * (theta[c[2] as usize] - ti);
-        a[3] += v[3] * (theta[c[3] as usize] - ti);
+        a[0] += v[0].into() * (theta[c[0] as usize] - ti);
+        a[1] += v[1].into() * (theta[c[1] as usize] - ti);
+        a[2] += v[2].into() * (theta[c[2] as usize] - ti);
+        a[3] += v[3].into() * (theta[c[3] as usize] - ti);
     }
     for (c, v) in cc.remainder().iter().zip(vc.remainder()) {
-        a[0] += v * (theta[*c as usize] - ti);
+        a[0] += (*v).into() * (theta[*c as usize] - ti);
     }
     (a[0] + a[1]) + (a[2] + a[3])
 }

@@ -470,6 +470,10 @@ pub struct RunSummary {
     /// after, iterations, and the range of factors applied to the pair conductances.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub consistency: Option<peritherm_core::weights::Consistency>,
+    /// How the explicit step read K, when the case asked for other than K's own u32 columns and
+    /// f64 values (`kernel.columns`, `kernel.precision`), e.g. "packed columns, f32 K".
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_storage: Option<String>,
     /// Comparison with the case's classical reference, per output time.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference: Vec<Comparison>,

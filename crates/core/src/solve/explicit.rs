@@ -6,9 +6,10 @@
 //! Buffers are allocated once; the bond sum is a parallel gather.
 
 use crate::error::Result;
-use crate::gather::Rows;
+use crate::gather::{ColumnIndex, Columns, Precision, Rows, StepStorage, Values};
 use crate::model::Model;
 use crate::operator::{Conductance, ROW_CHUNK};
+use crate::packed::PackedColumns;
 use crate::solve::exchange::Exchange;
 use crate::stencil::Stencils;
 use rayon::prelude::*;
@@ -66,8 +67,8 @@ fn euler_fused(
 /// Explicit integrator state with preallocated buffers.
 pub struct Explicit<'a> {
     model: &'a Model,
-    /// K as it is now: the model's, or an owned copy that growing cracks cut in place.
-    conductance: Cow<'a, Conductance>,
+    /// K as the step reads it.
+    bonds: StepBonds<'a>,
     /// Index of the next growing-crack cut in `model.growth`.
     next_cut: usize,
     /// The explicit scheme stepped.
@@ -76,19 +77,65 @@ pub struct Explicit<'a> {
     rates: [Vec<f64>; 4],
     /// The temperatures at an RK4 stage, °C.
     stage: Vec<f64>,
-    /// K as shared stencils for the Euler step (lattice clouds without growing cracks).
-    stencils: Option<Stencils>,
     /// The body rows this stepper computes: all, or a rank's in a distributed run.
     rows: Range<usize>,
     /// The other ranks of a distributed run.
     exchange: Option<&'a dyn Exchange>,
 }
 
+/// K as the explicit step reads it: the model's K (or a copy that growing cracks cut), and the
+/// storage the case asks for beside it.
+struct StepBonds<'a> {
+    /// K as it is now: the model's, or an owned copy that growing cracks cut in place.
+    conductance: Cow<'a, Conductance>,
+    /// K as shared stencils for the Euler step (lattice clouds without growing cracks, K in f64).
+    stencils: Option<Stencils>,
+    /// The columns of the rows stepped, packed (`kernel.columns = "packed"`, no stencils).
+    packed: Option<Box<PackedColumns>>,
+    /// K's values rounded to f32 (`kernel.precision = "f32"`), W/K.
+    rounded: Option<Vec<f32>>,
+    /// The column index and precision asked for.
+    storage: StepStorage,
+}
+
+impl StepBonds<'_> {
+    /// The storage the step reads: the stencils while K is the model's, else K's rows with
+    /// the column index and the precision asked for.
+    fn rows(&self) -> Rows<'_> {
+        if let (Cow::Borrowed(_), Some(st)) = (&self.conductance, &self.stencils) {
+            return Rows::Stencils(st);
+        }
+        let columns = match &self.packed {
+            Some(p) => Columns::Packed(p),
+            None => Columns::Csr(&self.conductance),
+        };
+        let values = match &self.rounded {
+            Some(v) => Values::F32(v),
+            None => Values::F64(&self.conductance.vals),
+        };
+        Rows::Bonds(columns, values)
+    }
+
+    /// Packs the columns of `rows` and rounds K as the storage asks (no packing where
+    /// stencils hold K).
+    fn pack(&mut self, rows: Range<usize>) {
+        let asked = self.storage.columns == ColumnIndex::Packed && self.stencils.is_none();
+        self.packed = match asked {
+            true => PackedColumns::build(&self.conductance, rows).map(Box::new),
+            false => None,
+        };
+        let f32 = self.storage.precision == Precision::F32;
+        self.rounded = f32.then(|| self.conductance.vals.iter().map(|&v| v as f32).collect());
+    }
+}
+
 /// The stencils of K for `scheme` on `model`: built for Euler without growing cracks, when
 /// the cloud repeats rows (lattices); None otherwise.
-fn stencils_for(model: &Model, scheme: ExplicitScheme) -> Option<Stencils> {
+fn stencils_for(model: &Model, scheme: ExplicitScheme, f32: bool) -> Option<Stencils> {
     match scheme {
-        ExplicitScheme::Euler if model.growth.is_empty() => Stencils::build(&model.conductance),
+        ExplicitScheme::Euler if model.growth.is_empty() && !f32 => {
+            Stencils::build(&model.conductance)
+        }
         _ => None,
     }
 }
@@ -113,14 +160,22 @@ impl<'a> Explicit<'a> {
         } else {
             Cow::Owned(model.conductance.clone())
         };
+        let f32 = model.step.precision == Precision::F32;
+        let mut bonds = StepBonds {
+            conductance,
+            stencils: stencils_for(model, scheme, f32),
+            packed: None,
+            rounded: None,
+            storage: model.step,
+        };
+        bonds.pack(0..nb);
         Explicit {
             model,
-            conductance,
+            bonds,
             next_cut: 0,
             scheme,
             rates,
             stage: vec![0.0; model.cloud.len()],
-            stencils: stencils_for(model, scheme),
             rows: 0..nb,
             exchange: None,
         }
@@ -133,28 +188,51 @@ impl<'a> Explicit<'a> {
     pub fn distribute(&mut self, exchange: &'a dyn Exchange) {
         self.rows = exchange.rows();
         self.exchange = Some(exchange);
+        self.bonds.pack(self.rows.clone());
     }
 
     /// Turns the stencils of K ([`crate::stencil`]) on or off for the Euler step and tells
     /// whether they are in use: they exist for Euler without growing cracks on clouds that
     /// repeat rows (lattices). Off forces the plain CSR rows; both give the same bits.
     pub fn set_stencils(&mut self, on: bool) -> bool {
-        self.stencils = match (on, self.stencils.take()) {
+        let b = &mut self.bonds;
+        b.stencils = match (on, b.stencils.take()) {
             (false, _) => None,
             (true, Some(s)) => Some(s),
-            (true, None) => stencils_for(self.model, self.scheme),
+            (true, None) => {
+                let f32 = b.storage.precision == Precision::F32;
+                stencils_for(self.model, self.scheme, f32)
+            }
         };
-        self.stencils.is_some()
+        b.pack(self.rows.clone());
+        b.stencils.is_some()
+    }
+
+    /// Reads K with the column index and precision of `storage` instead of the model's (the
+    /// stencils, where they exist, are kept for f64 and dropped for f32).
+    pub fn set_storage(&mut self, storage: StepStorage) {
+        self.bonds.storage = storage;
+        if storage.precision == Precision::F32 {
+            self.bonds.stencils = None;
+        }
+        self.bonds.pack(self.rows.clone());
     }
 
     /// Bytes held by the stencils of K (0 without them), B.
     pub fn stencil_bytes(&self) -> usize {
-        self.stencils.as_ref().map_or(0, Stencils::bytes)
+        self.bonds.stencils.as_ref().map_or(0, Stencils::bytes)
+    }
+
+    /// Bytes held beside K by the packed columns and the rounded values (0 without them), B.
+    pub fn storage_bytes(&self) -> usize {
+        let b = &self.bonds;
+        b.packed.as_ref().map_or(0, |p| p.bytes())
+            + b.rounded.as_ref().map_or(0, |v| v.capacity() * 4)
     }
 
     /// K as it is now (growing cracks cut it as their tips pass), W/K.
     pub fn conductance(&self) -> &Conductance {
-        &self.conductance
+        &self.bonds.conductance
     }
 
     /// Cuts, in place, the pairs whose growing-crack cut time has come by `t`.
@@ -162,10 +240,14 @@ impl<'a> Explicit<'a> {
         let cuts = &self.model.growth;
         while self.next_cut < cuts.len() && cuts[self.next_cut].time <= t {
             let c = cuts[self.next_cut];
-            let k = self.conductance.to_mut();
+            let b = &mut self.bonds;
+            let k = b.conductance.to_mut();
             for (row, e) in c.entries.into_iter().flatten() {
                 k.diag[row] -= k.vals[e] * (1.0 - c.mu);
                 k.vals[e] *= c.mu;
+                if let Some(r) = &mut b.rounded {
+                    r[e] = k.vals[e] as f32;
+                }
             }
             self.next_cut += 1;
         }
@@ -178,10 +260,7 @@ impl<'a> Explicit<'a> {
         let m = self.model;
         let rows = self.rows.clone();
         // the stencils are built from the model's K: not used once a copy of K is cut
-        let k = match (&self.conductance, &self.stencils) {
-            (Cow::Borrowed(_), Some(st)) => Rows::Stencils(st),
-            (k, _) => Rows::Csr(k),
-        };
+        let k = self.bonds.rows();
         let out = &mut self.rates[0];
         match self.scheme {
             ExplicitScheme::Euler if m.boundary.has_loads() => {
@@ -200,7 +279,7 @@ impl<'a> Explicit<'a> {
 
     /// One classical RK4 step of the rows of this stepper (the constraints set at each stage).
     fn rk4(&mut self, theta: &mut [f64], t: f64, h: f64) {
-        let (m, k, ex) = (self.model, Rows::Csr(&self.conductance), self.exchange);
+        let (m, k, ex) = (self.model, self.bonds.rows(), self.exchange);
         let r = self.rows.clone();
         let [k1, k2, k3, k4] = &mut self.rates;
         let stage = &mut self.stage;
@@ -243,7 +322,7 @@ impl<'a> Explicit<'a> {
             t0,
             dt,
             outputs,
-            |me, k, t, theta| on_output(k, t, theta, &me.conductance),
+            |me, k, t, theta| on_output(k, t, theta, &me.bonds.conductance),
             progress,
         )
     }
@@ -273,7 +352,7 @@ impl Stepper for Explicit<'_> {
         Ok(())
     }
     fn conductance_now(&mut self) -> &Conductance {
-        &self.conductance
+        &self.bonds.conductance
     }
 }
 

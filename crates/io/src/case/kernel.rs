@@ -2,8 +2,10 @@
 
 use super::Ctx;
 use crate::error::Result;
+use peritherm_core::gather::{ColumnIndex, Precision, StepStorage};
 use peritherm_core::kernel::{Calibration, Kernel, PartialVolume, Profile};
 use peritherm_core::material::{BondRule, Material};
+use peritherm_core::solve::integrator::{Integrator, Stepping};
 use peritherm_core::symmetry::Symmetry;
 use peritherm_core::weights::Order;
 use serde::Deserialize;
@@ -37,6 +39,12 @@ pub struct KernelSpec {
     /// Restore the horizon's second moment at nodes whose bonds a pre-crack cuts.
     #[serde(default)]
     pub crack_correction: bool,
+    /// The explicit step's column index: u32 (default) or packed (about 1 B per bond).
+    #[serde(default)]
+    pub columns: ColumnIndex,
+    /// The precision of K as the explicit step reads it: f64 (default) or f32.
+    #[serde(default)]
+    pub precision: Precision,
 }
 
 fn default_p() -> u8 {
@@ -60,6 +68,8 @@ impl Default for KernelSpec {
             consistency: None,
             linear_consistency: false,
             crack_correction: false,
+            columns: ColumnIndex::default(),
+            precision: Precision::default(),
         }
     }
 }
@@ -103,6 +113,31 @@ impl KernelSpec {
             ),
         )?;
         Ok(())
+    }
+
+    /// How the explicit step reads K. f32 is refused where it would not be used: implicit,
+    /// steady and phase-change runs solve with K in f64.
+    pub(super) fn step(
+        &self,
+        cx: Ctx,
+        integrator: Integrator,
+        materials: &[Material],
+    ) -> Result<StepStorage> {
+        let phase = materials.iter().any(|m| m.phase_change.is_some());
+        let explicit = matches!(integrator.stepping(), Stepping::Explicit(_));
+        if self.precision == Precision::F32 && (!explicit || phase) {
+            return Err(cx.err(
+                "kernel.precision",
+                format!(
+                    "\"f32\" applies to the explicit step (integrator = \"euler\" or \"rk4\", without phase change); {} solves with K in f64: remove the key or use an explicit integrator",
+                    if phase { "a phase-change run" } else { "this integrator" }
+                ),
+            ));
+        }
+        Ok(StepStorage {
+            columns: self.columns,
+            precision: self.precision,
+        })
     }
 
     /// The kernel of the model (`p` is 1 or 2).

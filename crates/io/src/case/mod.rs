@@ -397,6 +397,7 @@ impl CaseFile {
             None => None,
         };
         let integrator = self.time.integrator(cx, &materials)?;
+        let step = self.kernel.step(cx, integrator, &materials)?;
         let spec = ModelSpec {
             geometry,
             materials,
@@ -411,6 +412,7 @@ impl CaseFile {
                 .order(self.mesh.is_some() && !self.symmetry.is_symmetric()),
             crack_correction: self.kernel.crack_correction,
             symmetry: self.symmetry,
+            step,
         };
         let history = match self.history {
             Some(h) => Some(h.validate(cx, body.dim, &outputs, integrator)?),
