@@ -20,6 +20,11 @@ pub struct Material {
     pub phase_change: Option<PhaseChange>,
 }
 
+/// Whether any of `materials` freezes or melts (a phase-change run).
+pub fn any_phase_change(materials: &[Material]) -> bool {
+    materials.iter().any(|m| m.phase_change.is_some())
+}
+
 /// `[material.<name>.phase_change]`: the frozen phase and the latent heat (PCS2022,
 /// eqs. 1–3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

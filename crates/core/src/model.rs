@@ -11,7 +11,7 @@ use crate::expr::Expr;
 use crate::gather::StepStorage;
 use crate::horizons::Horizons;
 use crate::kernel::{Kernel, PartialVolume};
-use crate::material::{BondRule, Enthalpy, Material};
+use crate::material::{any_phase_change, BondRule, Enthalpy, Material};
 use crate::math::Point;
 use crate::operator::{Conductance, HalfConductance};
 use crate::partition::Partition;
@@ -341,7 +341,7 @@ fn check_spec(spec: &ModelSpec) -> Result<bool> {
         mat.check()
             .map_err(|(key, message)| Error::model(format!("material[{m}].{key}"), message))?;
     }
-    let phase = spec.materials.iter().any(|m| m.phase_change.is_some());
+    let phase = any_phase_change(&spec.materials);
     if phase
         && spec
             .faces

@@ -15,6 +15,7 @@ use peritherm_core::bc::FaceBc;
 use peritherm_core::cloud::mesh::{MeshGeometry, MeshRegion};
 use peritherm_core::cloud::Cloud;
 use peritherm_core::error::{Error, Result};
+use peritherm_core::material::any_phase_change;
 use peritherm_core::mesh::Mesh;
 use peritherm_core::model::{CrackShape, Geometry, ModelSpec};
 use std::path::{Path, PathBuf};
@@ -136,7 +137,7 @@ pub fn build_mesh(problem: &FemProblem) -> Result<(FemMesh, usize)> {
     let (spec, opts) = (problem.spec, problem.options);
     let h = opts.h;
     check_cracks(&spec.cracks)?;
-    if spec.materials.iter().any(|m| m.phase_change.is_some()) {
+    if any_phase_change(&spec.materials) {
         return Err(Error::model(
             "material",
             "the FEM reference is linear: phase change (material.<name>.phase_change) is not supported",

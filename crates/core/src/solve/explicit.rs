@@ -116,14 +116,18 @@ impl StepBonds<'_> {
         Rows::Bonds(columns, values)
     }
 
-    /// Packs the columns of `rows` and rounds K as the storage asks (no packing where
-    /// stencils hold K).
-    fn pack(&mut self, rows: Range<usize>) {
+    /// Packs the columns of `rows` as the storage asks (none where stencils hold K); depends
+    /// on the rows stepped and on the stencils.
+    fn pack_columns(&mut self, rows: Range<usize>) {
         let asked = self.storage.columns == ColumnIndex::Packed && self.stencils.is_none();
         self.packed = match asked {
             true => PackedColumns::build(&self.conductance, rows).map(Box::new),
             false => None,
         };
+    }
+
+    /// Rounds K's values to f32 where the storage asks for it; depends on the precision only.
+    fn round_values(&mut self) {
         let f32 = self.storage.precision == Precision::F32;
         self.rounded = f32.then(|| self.conductance.vals.iter().map(|&v| v as f32).collect());
     }
@@ -131,9 +135,9 @@ impl StepBonds<'_> {
 
 /// The stencils of K for `scheme` on `model`: built for Euler without growing cracks, when
 /// the cloud repeats rows (lattices); None otherwise.
-fn stencils_for(model: &Model, scheme: ExplicitScheme, f32: bool) -> Option<Stencils> {
+fn stencils_for(model: &Model, scheme: ExplicitScheme, precision: Precision) -> Option<Stencils> {
     match scheme {
-        ExplicitScheme::Euler if model.growth.is_empty() && !f32 => {
+        ExplicitScheme::Euler if model.growth.is_empty() && precision == Precision::F64 => {
             Stencils::build(&model.conductance)
         }
         _ => None,
@@ -160,15 +164,15 @@ impl<'a> Explicit<'a> {
         } else {
             Cow::Owned(model.conductance.clone())
         };
-        let f32 = model.step.precision == Precision::F32;
         let mut bonds = StepBonds {
             conductance,
-            stencils: stencils_for(model, scheme, f32),
+            stencils: stencils_for(model, scheme, model.step.precision),
             packed: None,
             rounded: None,
             storage: model.step,
         };
-        bonds.pack(0..nb);
+        bonds.pack_columns(0..nb);
+        bonds.round_values();
         Explicit {
             model,
             bonds,
@@ -188,7 +192,7 @@ impl<'a> Explicit<'a> {
     pub fn distribute(&mut self, exchange: &'a dyn Exchange) {
         self.rows = exchange.rows();
         self.exchange = Some(exchange);
-        self.bonds.pack(self.rows.clone());
+        self.bonds.pack_columns(self.rows.clone());
     }
 
     /// Turns the stencils of K ([`crate::stencil`]) on or off for the Euler step and tells
@@ -199,12 +203,9 @@ impl<'a> Explicit<'a> {
         b.stencils = match (on, b.stencils.take()) {
             (false, _) => None,
             (true, Some(s)) => Some(s),
-            (true, None) => {
-                let f32 = b.storage.precision == Precision::F32;
-                stencils_for(self.model, self.scheme, f32)
-            }
+            (true, None) => stencils_for(self.model, self.scheme, b.storage.precision),
         };
-        b.pack(self.rows.clone());
+        b.pack_columns(self.rows.clone());
         b.stencils.is_some()
     }
 
@@ -215,7 +216,8 @@ impl<'a> Explicit<'a> {
         if storage.precision == Precision::F32 {
             self.bonds.stencils = None;
         }
-        self.bonds.pack(self.rows.clone());
+        self.bonds.pack_columns(self.rows.clone());
+        self.bonds.round_values();
     }
 
     /// Bytes held by the stencils of K (0 without them), B.

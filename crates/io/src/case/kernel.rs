@@ -4,7 +4,7 @@ use super::Ctx;
 use crate::error::Result;
 use peritherm_core::gather::{ColumnIndex, Precision, StepStorage};
 use peritherm_core::kernel::{Calibration, Kernel, PartialVolume, Profile};
-use peritherm_core::material::{BondRule, Material};
+use peritherm_core::material::{any_phase_change, BondRule, Material};
 use peritherm_core::solve::integrator::{Integrator, Stepping};
 use peritherm_core::symmetry::Symmetry;
 use peritherm_core::weights::Order;
@@ -123,7 +123,7 @@ impl KernelSpec {
         integrator: Integrator,
         materials: &[Material],
     ) -> Result<StepStorage> {
-        let phase = materials.iter().any(|m| m.phase_change.is_some());
+        let phase = any_phase_change(materials);
         let explicit = matches!(integrator.stepping(), Stepping::Explicit(_));
         if self.precision == Precision::F32 && (!explicit || phase) {
             return Err(cx.err(

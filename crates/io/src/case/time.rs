@@ -3,7 +3,7 @@
 use super::{Ctx, ValueSpec};
 use crate::error::Result;
 use peritherm_core::expr::Expr;
-use peritherm_core::material::Material;
+use peritherm_core::material::{any_phase_change, Material};
 use peritherm_core::model::Initial;
 use peritherm_core::solve::Integrator;
 use serde::Deserialize;
@@ -103,7 +103,7 @@ impl TimeSpec {
     /// The integrator (default: euler with phase change, else rk4) and its adaptive-step keys:
     /// `tolerance` for a linear implicit scheme, `dt_max` with `tolerance`, `dt` up to `dt_max`.
     pub(super) fn integrator(&self, cx: Ctx, materials: &[Material]) -> Result<Integrator> {
-        let phase_change = materials.iter().any(|m| m.phase_change.is_some());
+        let phase_change = any_phase_change(materials);
         let integrator = self.integrator.unwrap_or(if phase_change {
             Integrator::Euler
         } else {
